@@ -1,0 +1,3 @@
+//! Markdown docs.
+use crate::model::Device;
+pub fn markdown(d: &Device) -> String { d.identity.name.clone() }
