@@ -76,8 +76,12 @@ fn write_output(output: Option<&Path>, text: &str) -> Result<(), String> {
     match output {
         Some(path) => std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display())),
         None => {
-            print!("{text}");
-            Ok(())
+            use std::io::Write as _;
+            // A closed pipe (`coforge eds x | head`) is not an error worth a panic.
+            match std::io::stdout().lock().write_all(text.as_bytes()) {
+                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(format!("cannot write to stdout: {e}")),
+                _ => Ok(()),
+            }
         }
     }
 }
@@ -119,7 +123,7 @@ fn run(cmd: Cmd) -> Result<ExitCode, String> {
             let Some(loaded) = load_reporting(&spec) else { return Ok(ExitCode::FAILURE) };
             let device = loaded.device().ok_or("spec did not load")?;
             let json = coforge_spec::eds::model_json(device, mode.as_deref(), node_id).map_err(|e| e.to_string())?;
-            println!("{json}");
+            write_output(None, &format!("{json}\n"))?;
             Ok(ExitCode::SUCCESS)
         }
         Cmd::Fmt { check, specs } => {

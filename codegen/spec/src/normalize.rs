@@ -239,7 +239,7 @@ fn identity(cx: &mut Cx<'_>, d: &S<raw::Device>) -> Identity {
     let u32_of = |cx: &mut Cx<'_>, n: &Num, what: &str| cx.int_in::<u32>(n, &none, what, 0, 0xFFFF_FFFF).unwrap_or(0);
     Identity {
         name: v.name.value.clone(),
-        ident: snake_case(&v.name.value),
+        ident: v.ident.as_ref().map_or_else(|| device_ident(&v.name.value), |i| i.value.clone()),
         vendor: v.vendor.value.clone(),
         vendor_id: u32_of(cx, &v.vendor_id, "vendor_id"),
         product_code: u32_of(cx, &v.product_code, "product_code"),
@@ -251,6 +251,19 @@ fn identity(cx: &mut Cx<'_>, d: &S<raw::Device>) -> Identity {
         datasheet_file: v.datasheet.value.file.clone(),
         span: span(d),
     }
+}
+
+/// `CO401Memory1` -> `co401memory1`, `CR3101 CANmem` -> `cr3101_canmem`: file and crate names.
+fn device_ident(name: &str) -> String {
+    let mut out = String::new();
+    for c in name.chars() {
+        if c.is_ascii_alphanumeric() {
+            out.push(c.to_ascii_lowercase());
+        } else if !out.is_empty() && !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    out.trim_end_matches('_').to_string()
 }
 
 fn level(cx: &mut Cx<'_>, s: &S<String>) -> Option<Level> {

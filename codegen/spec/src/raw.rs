@@ -76,6 +76,8 @@ pub struct Spec {
 #[serde(deny_unknown_fields)]
 pub struct Device {
     pub name: S<String>,
+    #[serde(default)]
+    pub ident: Option<S<String>>,
     pub vendor: S<String>,
     pub vendor_id: Num,
     pub product_code: Num,

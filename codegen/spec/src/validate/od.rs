@@ -9,7 +9,8 @@ use std::collections::BTreeMap;
 pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
     for (i, a) in d.objects.iter().enumerate() {
         for b in d.objects.iter().skip(i + 1).take_while(|b| b.index == a.index) {
-            if modes_overlap(&a.modes, &b.modes) {
+            // Two generated objects collide only through a repeated PDO: `pdo-duplicate` says so.
+            if modes_overlap(&a.modes, &b.modes) && !(a.generated && b.generated) {
                 let what = if b.generated { " (generated from `pdo:`; do not list PDO parameter objects in `objects:`)" } else { "" };
                 diags.push(Diagnostic::error("od-duplicate", b.span, format!("object {} is defined twice{what}", hex4(a.index))).note_at(a.span, "first defined here"));
             }
