@@ -43,6 +43,8 @@ enum Cmd {
         #[arg(long)]
         mode: Option<String>,
     },
+    /// Print a JSON summary of a spec: name, identifier, modes, EDS file names, counts.
+    Info { spec: PathBuf },
     /// Rewrite specs in canonical formatting, or with --check report files that differ.
     Fmt {
         #[arg(long)]
@@ -124,6 +126,12 @@ fn run(cmd: Cmd) -> Result<ExitCode, String> {
             let device = loaded.device().ok_or("spec did not load")?;
             let json = coforge_spec::eds::model_json(device, mode.as_deref(), node_id).map_err(|e| e.to_string())?;
             write_output(None, &format!("{json}\n"))?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Info { spec } => {
+            let Some(loaded) = load_reporting(&spec) else { return Ok(ExitCode::FAILURE) };
+            let device = loaded.device().ok_or("spec did not load")?;
+            write_output(None, &format!("{}\n", coforge_spec::eds::info_json(device)))?;
             Ok(ExitCode::SUCCESS)
         }
         Cmd::Fmt { check, specs } => {

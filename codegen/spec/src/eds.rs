@@ -197,6 +197,9 @@ pub fn model_json(d: &Device, mode: Option<&str>, node_id: u8) -> Result<String,
                 "data_type": e.data_type.code(),
                 "access": eds_access(d, o, e, mode),
                 "pdo_mapping": e.pdo_mapping,
+                "host_access": e.host_access.name(),
+                "host_write_before_can_enabled": e.host_write_when == crate::types::WriteWhen::BeforeCanEnabled,
+                "storage": e.storage.name(),
                 "default": default,
                 "dummy": is_dummy(o),
             }));
@@ -204,4 +207,23 @@ pub fn model_json(d: &Device, mode: Option<&str>, node_id: u8) -> Result<String,
     }
     let doc = serde_json::json!({ "device": d.identity.name, "mode": mode, "node_id": node_id, "entries": entries });
     serde_json::to_string_pretty(&doc).map_err(|e| ExportError(e.to_string()))
+}
+
+/// A summary for tools: names, modes and the EDS file of each mode.
+pub fn info_json(d: &Device) -> String {
+    let modes: Vec<Option<&str>> = d.mode_names();
+    let eds: Vec<serde_json::Value> = modes.iter().map(|m| serde_json::json!({ "mode": m, "file": file_name(d, *m) })).collect();
+    let doc = serde_json::json!({
+        "name": d.identity.name,
+        "ident": d.identity.ident,
+        "modes": d.modes.iter().map(|m| m.name.as_str()).collect::<Vec<_>>(),
+        "eds": eds,
+        "objects": d.objects.len(),
+        "entries": d.objects.iter().map(|o| o.entries.len()).sum::<usize>(),
+        "pdos": d.pdo.pdos.len(),
+        "emergencies": d.emergencies.len(),
+        "serial_commands": d.serial.as_ref().map_or(0, |s| s.commands.len()),
+        "errata": d.errata.len(),
+    });
+    serde_json::to_string_pretty(&doc).unwrap_or_default()
 }
