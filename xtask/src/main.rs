@@ -1,1 +1,146 @@
-fn main() {}
+//! `cargo xtask dist`: check every spec and build every output into `target/dist/`.
+//! `cargo xtask test`: install what the test suite needs, then run all of it.
+//!
+//! Both say what they install before they install it.
+#![forbid(unsafe_code)]
+
+mod setup;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.first().map(String::as_str) {
+        Some("dist") => dist(),
+        Some("test") => test(),
+        _ => {
+            eprintln!(
+                "usage: cargo xtask <dist|test>\n  dist  check every spec and write EDS files and docs into target/dist/\n  test  install missing tools, then run the whole test suite"
+            );
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+pub type Result<T = ()> = std::result::Result<T, String>;
+
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").canonicalize().unwrap_or_else(|_| PathBuf::from(".."))
+}
+
+fn specs() -> Result<Vec<PathBuf>> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("spec"))
+        .map_err(|e| format!("cannot list spec/: {e}"))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
+        .collect();
+    v.sort();
+    Ok(v)
+}
+
+/// Runs a command in the repository root, echoing it; fails on a non-zero exit.
+pub fn run(cmd: &mut Command) -> Result {
+    let shown = format!("{} {}", cmd.get_program().to_string_lossy(), cmd.get_args().map(|a| a.to_string_lossy()).collect::<Vec<_>>().join(" "));
+    println!("xtask: $ {shown}");
+    let status = cmd.current_dir(root()).status().map_err(|e| format!("cannot start `{shown}`: {e}"))?;
+    if status.success() { Ok(()) } else { Err(format!("`{shown}` failed ({status})")) }
+}
+
+fn write(path: &Path, text: &str) -> Result {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+fn dist() -> Result {
+    setup::rust_targets()?;
+    let out = root().join("target/dist");
+    let mut index = String::from("# coforge devices\n\n| Device | Spec | EDS | Objects | Errata |\n|---|---|---|---|---|\n");
+    let mut failed = 0;
+    for path in specs()? {
+        let rel = path.strip_prefix(root()).unwrap_or(&path).display().to_string();
+        let loaded = coforge_spec::load_str(&rel, &std::fs::read_to_string(&path).map_err(|e| format!("cannot read {rel}: {e}"))?);
+        if !loaded.diagnostics.items.is_empty() {
+            eprintln!("{}", loaded.render_diagnostics());
+        }
+        let Some(device) = loaded.device() else {
+            failed += 1;
+            continue;
+        };
+        let mut eds_files = Vec::new();
+        for mode in device.mode_names() {
+            let name = coforge_spec::eds::file_name(device, mode);
+            let text = coforge_spec::eds::export(device, mode).map_err(|e| e.to_string())?;
+            write(&out.join("eds").join(&name), &text)?;
+            eds_files.push(format!("[{name}](../eds/{name})"));
+        }
+        let doc = format!("{}.md", device.identity.ident);
+        write(&out.join("docs").join(&doc), &coforge_spec::docs::markdown(device))?;
+        index.push_str(&format!(
+            "| [{}]({doc}) | `{rel}` | {} | {} | {} |\n",
+            device.identity.name,
+            eds_files.join(", "),
+            device.objects.len(),
+            device.errata.len()
+        ));
+        println!("xtask: {rel}: {} EDS file(s), docs/{doc}", eds_files.len());
+    }
+    if failed > 0 {
+        return Err(format!("{failed} spec(s) have errors"));
+    }
+    write(&out.join("docs/index.md"), &index)?;
+    println!("xtask: dist written to {}", out.display());
+    Ok(())
+}
+
+fn cargo() -> Command {
+    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+}
+
+fn test() -> Result {
+    setup::rust_targets()?;
+    setup::rust_components()?;
+    let python = setup::python_venv()?;
+
+    println!("xtask: [1/5] formatting and lints");
+    run(cargo().args(["fmt", "--all", "--check"]))?;
+    run(cargo().args(["clippy", "--quiet", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
+
+    println!("xtask: [2/5] Rust tests");
+    run(cargo().args(["test", "--workspace"]))?;
+
+    println!("xtask: [3/5] specs: check and canonical formatting");
+    run(cargo().args(["build", "--quiet", "-p", "coforge"]))?;
+    let coforge = root().join("target/debug/coforge");
+    let spec_args: Vec<PathBuf> = specs()?;
+    run(Command::new(&coforge).arg("check").args(&spec_args))?;
+    run(Command::new(&coforge).args(["fmt", "--check"]).args(&spec_args))?;
+
+    println!("xtask: [4/5] main outputs build (cargo xtask dist)");
+    dist()?;
+
+    println!("xtask: [5/5] interoperability tests with python-canopen");
+    let status = Command::new(&python)
+        .args(["-m", "pytest", "-q", "tests/python"])
+        .env("COFORGE_BIN", &coforge)
+        .current_dir(root())
+        .status()
+        .map_err(|e| format!("cannot run pytest: {e}"))?;
+    match status.code() {
+        Some(0) => {}
+        // pytest's "no tests collected" must not pass as a green run.
+        Some(5) => return Err("pytest collected no tests in tests/python".into()),
+        _ => return Err(format!("pytest failed ({status})")),
+    }
+    println!("xtask: all tests passed");
+    Ok(())
+}

@@ -103,7 +103,15 @@ fn run(cmd: Cmd) -> Result<ExitCode, String> {
                     eprintln!("{}: {errors} error(s)", path.display());
                 } else if let Some(d) = loaded.device() {
                     let entries: usize = d.objects.iter().map(|o| o.entries.len()).sum();
-                    println!("{}: ok ({} objects, {entries} entries, {} PDOs, {} emergencies, {} serial commands, {} errata)", path.display(), d.objects.len(), d.pdo.pdos.len(), d.emergencies.len(), d.serial.as_ref().map_or(0, |s| s.commands.len()), d.errata.len());
+                    println!(
+                        "{}: ok ({} objects, {entries} entries, {} PDOs, {} emergencies, {} serial commands, {} errata)",
+                        path.display(),
+                        d.objects.len(),
+                        d.pdo.pdos.len(),
+                        d.emergencies.len(),
+                        d.serial.as_ref().map_or(0, |s| s.commands.len()),
+                        d.errata.len()
+                    );
                 }
             }
             Ok(if failed > 0 { ExitCode::FAILURE } else { ExitCode::SUCCESS })

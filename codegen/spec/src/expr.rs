@@ -161,10 +161,7 @@ pub fn parse_int(text: &str) -> Result<i64, ExprError> {
     } else {
         (lower.as_str(), 10)
     };
-    u64::from_str_radix(digits, radix)
-        .ok()
-        .and_then(|v| i64::try_from(v).ok())
-        .ok_or_else(|| ExprError(format!("`{text}` is not an integer literal")))
+    u64::from_str_radix(digits, radix).ok().and_then(|v| i64::try_from(v).ok()).ok_or_else(|| ExprError(format!("`{text}` is not an integer literal")))
 }
 
 struct Parser {

@@ -32,7 +32,9 @@ pub fn format(text: &str) -> Result<String, String> {
         let line = span.start.line();
         match &ev {
             Event::Comment(..) => return Err(format!("line {line}: comments are not allowed in spec files; put the text into a `description` or `note`")),
-            Event::Alias(_) | Event::Anchor(..) | Event::UnresolvedAlias(_) => return Err(format!("line {line}: anchors and aliases are not allowed in spec files")),
+            Event::Alias(_) | Event::Anchor(..) | Event::UnresolvedAlias(_) => {
+                return Err(format!("line {line}: anchors and aliases are not allowed in spec files"));
+            }
             Event::Scalar(_, _, anchor, tag) | Event::SequenceStart(_, anchor, tag) | Event::MappingStart(_, anchor, tag) if *anchor != 0 || tag.is_some() => {
                 return Err(format!("line {line}: anchors and tags are not allowed in spec files"));
             }

@@ -54,7 +54,11 @@ pub fn split(framing: &Framing, bytes: &[u8]) -> Result<Split, String> {
             }
             let after_len = &rest[lb..];
             if after_len.len() != payload_len + crc_len {
-                return Err(format!("the length field says a {payload_len}-byte payload, so the frame should be {} bytes, but it is {}", 1 + lb + payload_len + crc_len, bytes.len()));
+                return Err(format!(
+                    "the length field says a {payload_len}-byte payload, so the frame should be {} bytes, but it is {}",
+                    1 + lb + payload_len + crc_len,
+                    bytes.len()
+                ));
             }
             let (payload, crc_bytes) = after_len.split_at(payload_len);
             let mut covered = Vec::new();
@@ -67,7 +71,11 @@ pub fn split(framing: &Framing, bytes: &[u8]) -> Result<Split, String> {
             if crc.covers_payload {
                 covered.extend_from_slice(payload);
             }
-            let got = if crc.little_endian { crc_bytes.iter().rev().fold(0_u64, |a, &b| a << 8 | u64::from(b)) } else { crc_bytes.iter().fold(0_u64, |a, &b| a << 8 | u64::from(b)) };
+            let got = if crc.little_endian {
+                crc_bytes.iter().rev().fold(0_u64, |a, &b| a << 8 | u64::from(b))
+            } else {
+                crc_bytes.iter().fold(0_u64, |a, &b| a << 8 | u64::from(b))
+            };
             let want = crc.compute(&covered);
             if got != want {
                 return Err(format!("the CRC is {got:#06X} but the covered bytes give {want:#06X}"));
@@ -100,10 +108,16 @@ pub fn decode_fields(cmd: &Command, split: &Split) -> Result<BTreeMap<String, Ex
                 }
                 ExampleValue::Bytes(tail.to_vec())
             }
-            FieldType::Bytes(size) => ExampleValue::Bytes(data.get(at..at + usize::try_from(size).unwrap_or(0)).ok_or_else(|| format!("the frame ends inside field `{}`", f.name))?.to_vec()),
+            FieldType::Bytes(size) => ExampleValue::Bytes(
+                data.get(at..at + usize::try_from(size).unwrap_or(0)).ok_or_else(|| format!("the frame ends inside field `{}`", f.name))?.to_vec(),
+            ),
             FieldType::Unsigned(size) | FieldType::Signed(size) => {
                 let raw = data.get(at..at + usize::from(size)).ok_or_else(|| format!("the frame ends inside field `{}`", f.name))?;
-                let mut v = if f.big_endian { raw.iter().fold(0_i64, |a, &b| a << 8 | i64::from(b)) } else { raw.iter().rev().fold(0_i64, |a, &b| a << 8 | i64::from(b)) };
+                let mut v = if f.big_endian {
+                    raw.iter().fold(0_i64, |a, &b| a << 8 | i64::from(b))
+                } else {
+                    raw.iter().rev().fold(0_i64, |a, &b| a << 8 | i64::from(b))
+                };
                 if matches!(f.ty, FieldType::Signed(_)) && v >> (8 * size - 1) & 1 == 1 {
                     v -= 1 << (8 * size);
                 }

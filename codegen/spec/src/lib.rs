@@ -23,7 +23,6 @@ pub mod template;
 pub mod types;
 pub mod validate;
 
-
 pub use diag::{Diagnostic, Diagnostics, Severity, Source, Span};
 pub use model::Device;
 

@@ -65,8 +65,14 @@ pub struct Hardware {
 
 #[derive(Debug, Clone)]
 pub enum SelectorSource {
-    Pins { pins: Vec<String>, inverted: bool },
-    Object { index: u16, sub: u8 },
+    Pins {
+        pins: Vec<String>,
+        inverted: bool,
+    },
+    Object {
+        index: u16,
+        sub: u8,
+    },
     /// Set by configuration that is not part of the spec (CANopenIA's binary EDS).
     Configuration,
 }

@@ -7,9 +7,9 @@
 use crate::diag::{Diagnostic, Diagnostics, Span};
 use crate::expr::{Expr, Vars};
 use crate::model::*;
-use crate::raw::{self, Num, Scalar, S};
+use crate::raw::{self, Num, S, Scalar};
 use crate::template::interpolate;
-use crate::types::{snake_case, Access, DataType, HostAccess, ObjectKind, Storage, Sub0, WriteWhen};
+use crate::types::{Access, DataType, HostAccess, ObjectKind, Storage, Sub0, WriteWhen, snake_case};
 use std::collections::{BTreeMap, BTreeSet};
 
 pub const FORMAT_VERSION: u32 = 1;
@@ -114,7 +114,11 @@ impl Cx<'_> {
         for m in &list.value {
             if !self.modes.contains(&m.value) {
                 let known: Vec<_> = self.modes.iter().cloned().collect();
-                let msg = if known.is_empty() { format!("mode `{}` is used but the spec declares no `modes`", m.value) } else { format!("unknown mode `{}`; declared modes: {}", m.value, known.join(", ")) };
+                let msg = if known.is_empty() {
+                    format!("mode `{}` is used but the spec declares no `modes`", m.value)
+                } else {
+                    format!("unknown mode `{}`; declared modes: {}", m.value, known.join(", "))
+                };
                 self.err("spec-mode", span(m), msg);
             }
             set.insert(m.value.clone());
@@ -122,10 +126,10 @@ impl Cx<'_> {
         if list.value.is_empty() {
             self.err("spec-mode", span(list), "`modes` must not be empty (omit it for every mode)");
         }
-        if let Some(parent) = inherited {
-            if !set.is_subset(parent) {
-                self.err("spec-mode", span(list), "an entry's `modes` must be a subset of its object's `modes`");
-            }
+        if let Some(parent) = inherited
+            && !set.is_subset(parent)
+        {
+            self.err("spec-mode", span(list), "an entry's `modes` must be a subset of its object's `modes`");
         }
         Some(set)
     }
@@ -226,7 +230,14 @@ pub fn normalize(spec: &raw::Spec, diags: &mut Diagnostics) -> Device {
         .iter()
         .map(|e| {
             let e2 = &e.value;
-            Erratum { id: e2.id.value.clone(), location: e2.location.value.clone(), datasheet: e2.datasheet.value.clone(), choice: e2.choice.value.clone(), reason: e2.reason.value.clone(), span: span(e) }
+            Erratum {
+                id: e2.id.value.clone(),
+                location: e2.location.value.clone(),
+                datasheet: e2.datasheet.value.clone(),
+                choice: e2.choice.value.clone(),
+                reason: e2.reason.value.clone(),
+                span: span(e),
+            }
         })
         .collect();
 
@@ -290,9 +301,16 @@ fn hardware(cx: &mut Cx<'_>, h: &raw::Hardware) -> Hardware {
             .value
             .settings
             .iter()
-            .filter_map(|s| Some(PinSetting { pin: s.value.pin.value.clone(), level: level(cx, &s.value.level)?, meaning: s.value.meaning.clone(), span: span(s) }))
+            .filter_map(|s| {
+                Some(PinSetting { pin: s.value.pin.value.clone(), level: level(cx, &s.value.level)?, meaning: s.value.meaning.clone(), span: span(s) })
+            })
             .collect();
-        ConfigPins { pins: c.value.pins.iter().map(|p| p.value.clone()).collect(), inverted: c.value.inverted, settings, description: c.value.description.clone().unwrap_or_default() }
+        ConfigPins {
+            pins: c.value.pins.iter().map(|p| p.value.clone()).collect(),
+            inverted: c.value.inverted,
+            settings,
+            description: c.value.description.clone().unwrap_or_default(),
+        }
     });
     Hardware { node_id, can_bitrate, serial_bitrate, config_pins }
 }
@@ -339,7 +357,14 @@ fn selector(cx: &mut Cx<'_>, s: &S<raw::Selector>) -> Option<Selector> {
             span: span(c),
         });
     }
-    Some(Selector { source, unit: v.unit.as_ref().map(|u| u.value.clone()), range, codes, description: v.description.clone().unwrap_or_default(), span: span(s) })
+    Some(Selector {
+        source,
+        unit: v.unit.as_ref().map(|u| u.value.clone()),
+        range,
+        codes,
+        description: v.description.clone().unwrap_or_default(),
+        span: span(s),
+    })
 }
 
 fn mode(cx: &mut Cx<'_>, m: &S<raw::Mode>) -> Mode {
@@ -432,7 +457,17 @@ fn object(cx: &mut Cx<'_>, item: &S<raw::Object>, vars: &Vars) -> Option<Object>
             cx.err("spec-structure", at, format!("{} object {index:#06X} needs `subs`", kind.name()));
             return None;
         };
-        let stray = [f.data_type.map(span), f.access.map(span), f.default.map(span), f.host_access.map(span), f.pdo_mapping.map(span), f.length.map(span), f.low.map(span), f.high.map(span), f.unit.map(span)];
+        let stray = [
+            f.data_type.map(span),
+            f.access.map(span),
+            f.default.map(span),
+            f.host_access.map(span),
+            f.pdo_mapping.map(span),
+            f.length.map(span),
+            f.low.map(span),
+            f.high.map(span),
+            f.unit.map(span),
+        ];
         if let Some(s) = stray.into_iter().flatten().next() {
             cx.err("spec-structure", s, "entry keys of an ARRAY/RECORD belong on its `subs`");
         }
@@ -480,7 +515,11 @@ fn expand_entries(cx: &mut Cx<'_>, items: &[S<raw::Entry>], vars: &Vars, storage
 
 fn entry(cx: &mut Cx<'_>, f: raw::EntryFields<'_>, sub: u8, at: Span, vars: &Vars, storage: Storage, modes: &ModeSet) -> Option<Entry> {
     let (Some(name_s), Some(type_s), Some(access_s)) = (f.name, f.data_type, f.access) else {
-        let missing: Vec<_> = [("name", f.name.is_none()), ("type", f.data_type.is_none()), ("access", f.access.is_none())].into_iter().filter(|m| m.1).map(|m| format!("`{}`", m.0)).collect();
+        let missing: Vec<_> = [("name", f.name.is_none()), ("type", f.data_type.is_none()), ("access", f.access.is_none())]
+            .into_iter()
+            .filter(|m| m.1)
+            .map(|m| format!("`{}`", m.0))
+            .collect();
         cx.err("spec-structure", at, format!("entry is missing {}", missing.join(", ")));
         return None;
     };
@@ -608,10 +647,20 @@ fn pdo_set(cx: &mut Cx<'_>, dir: PdoDir, set: &S<raw::PdoSet>) -> Option<(PdoSet
         let Some(cob_id) = cx.expr(&d.cob_id, &none, "cob_id") else { continue };
         let Some(transmission_type) = cx.int_in::<u8>(&d.transmission_type, &none, "transmission_type", 0, 255) else { continue };
         let mut opt = |n: &Option<Num>, what: &str, hi: i64| n.as_ref().map_or(Some(0), |n| cx.int_in::<i64>(n, &none, what, 0, hi));
-        let (Some(inhibit), Some(event), Some(sync_start)) = (opt(&d.inhibit_time, "inhibit_time", 0xFFFF), opt(&d.event_timer, "event_timer", 0xFFFF), opt(&d.sync_start, "sync_start", 240)) else { continue };
+        let (Some(inhibit), Some(event), Some(sync_start)) =
+            (opt(&d.inhibit_time, "inhibit_time", 0xFFFF), opt(&d.event_timer, "event_timer", 0xFFFF), opt(&d.sync_start, "sync_start", 240))
+        else {
+            continue;
+        };
         let mut map = Vec::new();
         for m in &d.map {
-            let (Some(index), Some(sub), Some(bits)) = (cx.int_in(&m.value.index, &none, "mapped index", 1, 0xFFFF), cx.int_in(&m.value.sub, &none, "mapped sub-index", 0, 255), cx.int_in(&m.value.bits, &none, "mapped bit length", 1, 64)) else { continue };
+            let (Some(index), Some(sub), Some(bits)) = (
+                cx.int_in(&m.value.index, &none, "mapped index", 1, 0xFFFF),
+                cx.int_in(&m.value.sub, &none, "mapped sub-index", 0, 255),
+                cx.int_in(&m.value.bits, &none, "mapped bit length", 1, 64),
+            ) else {
+                continue;
+            };
             map.push(Mapping { index, sub, bits, span: span(m) });
         }
         pdos.push(Pdo {
@@ -633,27 +682,35 @@ fn pdo_set(cx: &mut Cx<'_>, dir: PdoDir, set: &S<raw::PdoSet>) -> Option<(PdoSet
     Some((params, pdos))
 }
 
-/// A generated entry of a PDO parameter object.
-fn pdo_entry(sub: u8, name: String, data_type: DataType, access: Access, default: i64, storage: Storage, pdo: &Pdo, unit: &str) -> Entry {
-    Entry {
-        sub,
-        ident: snake_case(&name),
-        name,
-        data_type,
-        length: None,
-        access,
-        host_access: HostAccess::None,
-        host_override: false,
-        host_write_when: WriteWhen::Always,
-        pdo_mapping: false,
-        default: Some(Value::Int(Expr::Num(default))),
-        low: None,
-        high: None,
-        unit: unit.to_string(),
-        storage,
-        description: String::new(),
-        modes: pdo.modes.clone(),
-        spans: EntrySpans { at: pdo.span, data_type: pdo.span, access: pdo.span, default: pdo.span, low: pdo.span, high: pdo.span },
+/// Builds the generated entries of one PDO's parameter objects.
+struct PdoEntries<'a> {
+    pdo: &'a Pdo,
+    storage: Storage,
+}
+
+impl PdoEntries<'_> {
+    fn entry(&self, sub: u8, name: String, data_type: DataType, access: Access, default: i64) -> Entry {
+        let at = self.pdo.span;
+        Entry {
+            sub,
+            ident: snake_case(&name),
+            name,
+            data_type,
+            length: None,
+            access,
+            host_access: HostAccess::None,
+            host_override: false,
+            host_write_when: WriteWhen::Always,
+            pdo_mapping: false,
+            default: Some(Value::Int(Expr::Num(default))),
+            low: None,
+            high: None,
+            unit: String::new(),
+            storage: self.storage,
+            description: String::new(),
+            modes: self.pdo.modes.clone(),
+            spans: EntrySpans { at, data_type: at, access: at, default: at, low: at, high: at },
+        }
     }
 }
 
@@ -671,7 +728,8 @@ fn pdo_objects(config: &PdoConfig, persistent: bool) -> Vec<Object> {
         let n = pdo.number;
         let kind = pdo.dir.name();
         let highest = set.comm_subs.iter().copied().max().unwrap_or(0);
-        let mut comm = vec![pdo_entry(0, "Highest sub-index supported".into(), DataType::Unsigned8, Access::Ro, i64::from(highest), storage, pdo, "")];
+        let make = PdoEntries { pdo, storage };
+        let mut comm = vec![make.entry(0, "Highest sub-index supported".into(), DataType::Unsigned8, Access::Ro, i64::from(highest))];
         for &sub in &set.comm_subs {
             let (name, ty, default, unit) = match sub {
                 1 => (format!("COB-ID used by {kind}"), DataType::Unsigned32, 0, ""),
@@ -681,7 +739,8 @@ fn pdo_objects(config: &PdoConfig, persistent: bool) -> Vec<Object> {
                 5 => ("Event timer".to_string(), DataType::Unsigned16, i64::from(pdo.event_timer), "ms"),
                 _ => ("SYNC start value".to_string(), DataType::Unsigned8, i64::from(pdo.sync_start), ""),
             };
-            let mut e = pdo_entry(sub, name, ty, set.comm_access, default, storage, pdo, unit);
+            let mut e = make.entry(sub, name, ty, set.comm_access, default);
+            e.unit = unit.to_string();
             if sub == 1 {
                 e.default = Some(Value::Int(pdo.cob_id.clone()));
                 e.spans.default = pdo.cob_id_span;
@@ -704,10 +763,10 @@ fn pdo_objects(config: &PdoConfig, persistent: bool) -> Vec<Object> {
             span: pdo.span,
         });
         let count = i64::try_from(pdo.map.len()).unwrap_or(i64::MAX);
-        let mut mapping = vec![pdo_entry(0, "Number of mapped objects".into(), DataType::Unsigned8, set.mapping_access, count, storage, pdo, "")];
+        let mut mapping = vec![make.entry(0, "Number of mapped objects".into(), DataType::Unsigned8, set.mapping_access, count)];
         for sub in 1..=set.max_mapped {
             let value = pdo.map.get(usize::from(sub - 1)).map_or(0, |m| i64::from(m.encoded()));
-            let mut e = pdo_entry(sub, format!("Mapped object {sub}"), DataType::Unsigned32, set.mapping_access, value, storage, pdo, "");
+            let mut e = make.entry(sub, format!("Mapped object {sub}"), DataType::Unsigned32, set.mapping_access, value);
             if let Some(m) = pdo.map.get(usize::from(sub - 1)) {
                 e.spans.default = m.span;
             }
@@ -745,6 +804,8 @@ fn apply_host_access(objects: &mut [Object], rule: Option<&HostRule>) {
                 HostRead::None => false,
                 HostRead::Listed => rule.readable.iter().any(|r| r.contains(o.index, e.sub)),
             };
+            // Sub 0 of an ARRAY/RECORD describes its structure; no device rule makes it writable.
+            let structural = o.kind.has_subs() && e.sub == 0 && o.sub0 == Sub0::Highest;
             let (write, when) = match rule.write {
                 HostWrite::All => (e.access != Access::Const, WriteWhen::Always),
                 HostWrite::None => (false, WriteWhen::Always),
@@ -754,7 +815,7 @@ fn apply_host_access(objects: &mut [Object], rule: Option<&HostRule>) {
                     None => (false, WriteWhen::Always),
                 },
             };
-            e.host_access = HostAccess::from_flags(read, write);
+            e.host_access = HostAccess::from_flags(read, write && !structural);
             e.host_write_when = when;
         }
     }
@@ -858,11 +919,27 @@ fn serial(cx: &mut Cx<'_>, s: &S<raw::Serial>) -> Option<Serial> {
     let error_bits = v
         .error_bits
         .iter()
-        .filter_map(|b| Some(ErrorBit { bit: cx.int_in(&b.value.bit, &none, "error bit", 0, 63)?, name: b.value.name.value.clone(), description: b.value.description.clone().unwrap_or_default(), span: span(b) }))
+        .filter_map(|b| {
+            Some(ErrorBit {
+                bit: cx.int_in(&b.value.bit, &none, "error bit", 0, 63)?,
+                name: b.value.name.value.clone(),
+                description: b.value.description.clone().unwrap_or_default(),
+                span: span(b),
+            })
+        })
         .collect();
     let commands = v.commands.iter().filter_map(|c| command(cx, c, &framing)).collect();
-    let settings = v.settings.as_ref().map(|st| SerialSettings { data_bits: st.value.data_bits, parity: st.value.parity.value.clone(), stop_bits: st.value.stop_bits });
-    Some(Serial { settings, framing, host_access, error_bits, commands, description: v.description.clone().unwrap_or_default(), framing_span: span(&v.framing) })
+    let settings =
+        v.settings.as_ref().map(|st| SerialSettings { data_bits: st.value.data_bits, parity: st.value.parity.value.clone(), stop_bits: st.value.stop_bits });
+    Some(Serial {
+        settings,
+        framing,
+        host_access,
+        error_bits,
+        commands,
+        description: v.description.clone().unwrap_or_default(),
+        framing_span: span(&v.framing),
+    })
 }
 
 fn framing(cx: &mut Cx<'_>, f: &S<raw::Framing>) -> Option<Framing> {
@@ -890,10 +967,10 @@ fn framing(cx: &mut Cx<'_>, f: &S<raw::Framing>) -> Option<Framing> {
         }
     };
     for (key, sp) in given {
-        if let Some(sp) = sp {
-            if !allowed.contains(&key) {
-                cx.err("spec-structure", sp, format!("`{key}` does not apply to `{}` framing", v.kind.value));
-            }
+        if let Some(sp) = sp
+            && !allowed.contains(&key)
+        {
+            cx.err("spec-structure", sp, format!("`{key}` does not apply to `{}` framing", v.kind.value));
         }
     }
     let mut need = |n: &Option<Num>, key: &str, lo: i64, hi: i64| -> Option<i64> {
@@ -965,7 +1042,20 @@ fn crc_params(cx: &mut Cx<'_>, c: &S<raw::Crc>) -> Option<CrcParams> {
             other => cx.err("spec-value", span(part), format!("unknown CRC coverage `{other}`; expected start, length, payload")),
         }
     }
-    Some(CrcParams { width, poly, init, reflect_in: v.reflect_in, reflect_out: v.reflect_out, xor_out, check, little_endian, covers_start: covers.0, covers_length: covers.1, covers_payload: covers.2, check_span: span(&v.check) })
+    Some(CrcParams {
+        width,
+        poly,
+        init,
+        reflect_in: v.reflect_in,
+        reflect_out: v.reflect_out,
+        xor_out,
+        check,
+        little_endian,
+        covers_start: covers.0,
+        covers_length: covers.1,
+        covers_payload: covers.2,
+        check_span: span(&v.check),
+    })
 }
 
 fn host_rule(cx: &mut Cx<'_>, h: &S<raw::HostAccess>) -> Option<HostRule> {
@@ -1094,7 +1184,9 @@ fn command(cx: &mut Cx<'_>, c: &S<raw::Command>, framing: &Framing) -> Option<Co
         FieldType::Tail { max } => Some(max),
         _ => None,
     });
-    let len_int = |cx: &mut Cx<'_>, s: &Scalar, sp: &S<raw::Length>| -> Option<u32> { cx.int_in(&S { value: s.clone(), referenced: sp.referenced, defined: sp.defined }, &none, "length", 0, 0xFFFF) };
+    let len_int = |cx: &mut Cx<'_>, s: &Scalar, sp: &S<raw::Length>| -> Option<u32> {
+        cx.int_in(&S { value: s.clone(), referenced: sp.referenced, defined: sp.defined }, &none, "length", 0, 0xFFFF)
+    };
     let length = match &v.length {
         Some(l) => match &l.value {
             raw::Length::Fixed(n) => {
@@ -1106,7 +1198,12 @@ fn command(cx: &mut Cx<'_>, c: &S<raw::Command>, framing: &Framing) -> Option<Co
         None => (fixed, fixed + tail_max.unwrap_or(0)),
     };
     let ack = match &v.ack {
-        Some(a) => Some(Ack { field: a.value.field.value.clone(), positive: cx.int(&a.value.positive, &none, "positive")?, negative: cx.int(&a.value.negative, &none, "negative")?, span: span(a) }),
+        Some(a) => Some(Ack {
+            field: a.value.field.value.clone(),
+            positive: cx.int(&a.value.positive, &none, "positive")?,
+            negative: cx.int(&a.value.negative, &none, "negative")?,
+            span: span(a),
+        }),
         None => None,
     };
     let mut examples = Vec::new();
@@ -1127,12 +1224,13 @@ fn command(cx: &mut Cx<'_>, c: &S<raw::Command>, framing: &Framing) -> Option<Co
         };
         let mut values = BTreeMap::new();
         for (name, val) in &ex.value.fields {
+            // Strings for byte fields are hex bytes (`"81"` is one byte 0x81); for integer
+            // fields they are expressions.
+            let byte_field = fields.iter().any(|f| &f.name == name && matches!(f.ty, FieldType::Bytes(_) | FieldType::Tail { .. }));
             let parsed = match &val.value {
                 Scalar::Int(i) => i64::try_from(*i).ok().map(ExampleValue::Int),
-                Scalar::Str(s) => match Expr::parse(s).and_then(|e| e.eval(&none, None)) {
-                    Ok(i) => Some(ExampleValue::Int(i)),
-                    Err(_) => hex_bytes(s, false).ok().map(|b| ExampleValue::Bytes(b.into_iter().flatten().collect())),
-                },
+                Scalar::Str(s) if byte_field => hex_bytes(s, false).ok().map(|b| ExampleValue::Bytes(b.into_iter().flatten().collect())),
+                Scalar::Str(s) => Expr::parse(s).and_then(|e| e.eval(&none, None)).ok().map(ExampleValue::Int),
                 _ => None,
             };
             match parsed {
@@ -1198,7 +1296,11 @@ fn fields(cx: &mut Cx<'_>, list: &[S<raw::Field>], framing: &Framing) -> Option<
                 },
             },
             other => {
-                cx.err("spec-value", span(&v.field_type), format!("unknown field type `{other}`; expected one of: u8, u16, u24, u32, i8, i16, i32, bytes, tail"));
+                cx.err(
+                    "spec-value",
+                    span(&v.field_type),
+                    format!("unknown field type `{other}`; expected one of: u8, u16, u24, u32, i8, i16, i32, bytes, tail"),
+                );
                 ok = false;
                 continue;
             }
@@ -1227,7 +1329,15 @@ fn fields(cx: &mut Cx<'_>, list: &[S<raw::Field>], framing: &Framing) -> Option<
             None => next,
         };
         next = at + ty.fixed_size();
-        out.push(Field { name: v.name.value.clone(), ty, big_endian, at, explicit_at: v.at.is_some(), description: v.description.clone().unwrap_or_default(), span: span(f) });
+        out.push(Field {
+            name: v.name.value.clone(),
+            ty,
+            big_endian,
+            at,
+            explicit_at: v.at.is_some(),
+            description: v.description.clone().unwrap_or_default(),
+            span: span(f),
+        });
     }
     ok.then_some(out)
 }

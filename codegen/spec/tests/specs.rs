@@ -83,7 +83,10 @@ fn co401gw1_modes_and_side_dependent_access() {
     // The digital-only mode doubles the digital I/O bytes.
     let inputs = |m| d.object(0x6000, Some(m)).map(|o| o.entries.len());
     assert!(inputs("digital") > inputs("mixed"));
-    assert!(matches!(d.serial.as_ref().map(|s| &s.framing), Some(Framing::LengthByte { inter_byte_timeout_ms: 10, resync_pause_ms: 50, extension_threshold: 0x80 })));
+    assert!(matches!(
+        d.serial.as_ref().map(|s| &s.framing),
+        Some(Framing::LengthByte { inter_byte_timeout_ms: 10, resync_pause_ms: 50, extension_threshold: 0x80 })
+    ));
     for mode in ["mixed", "digital"] {
         assert!(eds::export(&d, Some(mode)).is_ok());
     }

@@ -2,7 +2,7 @@
 
 use super::hex4;
 use crate::diag::{Diagnostic, Diagnostics};
-use crate::model::{modes_overlap, Device};
+use crate::model::{Device, modes_overlap};
 
 pub fn example(d: &Device, diags: &mut Diagnostics) {
     for e in &d.emergencies {
@@ -12,7 +12,14 @@ pub fn example(d: &Device, diags: &mut Diagnostics) {
         if !matches {
             let show = |b: &[Option<u8>]| b.iter().map(|x| x.map_or("xx".to_string(), |v| format!("{v:02X}"))).collect::<Vec<_>>().join(" ");
             let given: Vec<Option<u8>> = ex.iter().copied().map(Some).collect();
-            diags.push(Diagnostic::error("emcy-example", e.example_span, format!("example {} of emergency `{}` does not match its fields, which give {}", show(&given), e.name, show(&frame))).note("bytes 0..1 are the code (little-endian), byte 2 the error register, bytes 3..7 `manufacturer`"));
+            diags.push(
+                Diagnostic::error(
+                    "emcy-example",
+                    e.example_span,
+                    format!("example {} of emergency `{}` does not match its fields, which give {}", show(&given), e.name, show(&frame)),
+                )
+                .note("bytes 0..1 are the code (little-endian), byte 2 the error register, bytes 3..7 `manufacturer`"),
+            );
         }
     }
 }
@@ -27,9 +34,18 @@ pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
                 continue;
             }
             if a.name == b.name {
-                diags.push(Diagnostic::error("emcy-duplicate", b.span, format!("emergency `{}` is defined twice", b.name)).note_at(a.span, "first defined here"));
+                diags.push(
+                    Diagnostic::error("emcy-duplicate", b.span, format!("emergency `{}` is defined twice", b.name)).note_at(a.span, "first defined here"),
+                );
             } else if a.frame() == b.frame() {
-                diags.push(Diagnostic::error("emcy-duplicate", b.span, format!("emergencies `{}` and `{}` send the same frame; a master cannot tell them apart", a.name, b.name)).note_at(a.span, "the other emergency"));
+                diags.push(
+                    Diagnostic::error(
+                        "emcy-duplicate",
+                        b.span,
+                        format!("emergencies `{}` and `{}` send the same frame; a master cannot tell them apart", a.name, b.name),
+                    )
+                    .note_at(a.span, "the other emergency"),
+                );
             }
         }
     }
@@ -37,10 +53,10 @@ pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
 
 pub fn reference(d: &Device, diags: &mut Diagnostics) {
     for e in &d.emergencies {
-        if let Some(index) = e.enabled_by {
-            if !d.objects.iter().any(|o| o.index == index) {
-                diags.push(Diagnostic::error("emcy-reference", e.span, format!("emergency `{}` is enabled by {}, which does not exist", e.name, hex4(index))));
-            }
+        if let Some(index) = e.enabled_by
+            && !d.objects.iter().any(|o| o.index == index)
+        {
+            diags.push(Diagnostic::error("emcy-reference", e.span, format!("emergency `{}` is enabled by {}, which does not exist", e.name, hex4(index))));
         }
     }
 }

@@ -25,19 +25,25 @@ fn check_codes(name: &str, s: &Selector, width: Option<u32>, diags: &mut Diagnos
     let mut seen = BTreeMap::new();
     for row in &s.codes {
         if let Some(max) = max.filter(|&m| row.code < 0 || row.code > m) {
-            diags.push(Diagnostic::error("hardware-codes", row.span, format!("code {} of `{name}` does not fit its {} bits (0..={max})", row.code, width.unwrap_or(0))));
+            diags.push(Diagnostic::error(
+                "hardware-codes",
+                row.span,
+                format!("code {} of `{name}` does not fit its {} bits (0..={max})", row.code, width.unwrap_or(0)),
+            ));
         }
         if let Some(first) = seen.insert(row.code, row.span) {
-            diags.push(Diagnostic::error("hardware-codes", row.span, format!("code {} of `{name}` is listed twice", row.code)).note_at(first, "first listed here"));
+            diags.push(
+                Diagnostic::error("hardware-codes", row.span, format!("code {} of `{name}` is listed twice", row.code)).note_at(first, "first listed here"),
+            );
         }
         if let Some((lo, hi)) = s.range.filter(|(lo, hi)| (*lo..=*hi).contains(&row.code)) {
             diags.push(Diagnostic::error("hardware-codes", row.span, format!("code {} of `{name}` is already covered by its range {lo}..={hi}", row.code)));
         }
     }
-    if let (Some((lo, hi)), Some(max)) = (s.range, max) {
-        if lo < 0 || hi > max || lo > hi {
-            diags.push(Diagnostic::error("hardware-codes", s.span, format!("range {lo}..={hi} of `{name}` does not fit 0..={max}")));
-        }
+    if let (Some((lo, hi)), Some(max)) = (s.range, max)
+        && (lo < 0 || hi > max || lo > hi)
+    {
+        diags.push(Diagnostic::error("hardware-codes", s.span, format!("range {lo}..={hi} of `{name}` does not fit 0..={max}")));
     }
 }
 
@@ -65,10 +71,10 @@ pub fn mode_select(d: &Device, diags: &mut Diagnostics) {
                 diags.push(Diagnostic::error("mode-select", m.span, format!("mode `{}` is selected by pin `{pin}`, which is not a configuration pin", m.name)));
             }
         }
-        if let Some(cmd) = &m.command {
-            if !d.serial.as_ref().is_some_and(|s| s.commands.iter().any(|c| &c.name == cmd)) {
-                diags.push(Diagnostic::error("mode-select", m.span, format!("mode `{}` is selected by command `{cmd}`, which is not a serial command", m.name)));
-            }
+        if let Some(cmd) = &m.command
+            && !d.serial.as_ref().is_some_and(|s| s.commands.iter().any(|c| &c.name == cmd))
+        {
+            diags.push(Diagnostic::error("mode-select", m.span, format!("mode `{}` is selected by command `{cmd}`, which is not a serial command", m.name)));
         }
     }
 }

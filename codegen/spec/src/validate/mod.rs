@@ -22,7 +22,11 @@ pub struct Rule {
 /// Every rule, in the order they run.
 pub const RULES: &[Rule] = &[
     Rule { id: "od-duplicate", summary: "an index, or a sub-index within an object, is defined twice in one mode", check: od::duplicate },
-    Rule { id: "od-ident-collision", summary: "two objects (or two subs of one object) get the same identifier after case conversion", check: od::ident_collision },
+    Rule {
+        id: "od-ident-collision",
+        summary: "two objects (or two subs of one object) get the same identifier after case conversion",
+        check: od::ident_collision,
+    },
     Rule { id: "od-index-range", summary: "an index lies outside the ranges CiA 301 allows for objects", check: od::index_range },
     Rule { id: "od-mandatory", summary: "a mandatory object (1000, 1001, 1018 with sub 1) is missing", check: od::mandatory },
     Rule { id: "od-sub0", summary: "ARRAY/RECORD sub 0 is not a read-only UNSIGNED8 equal to the highest sub-index", check: od::sub0 },

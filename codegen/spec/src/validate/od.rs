@@ -2,7 +2,7 @@
 
 use super::hex4;
 use crate::diag::{Diagnostic, Diagnostics};
-use crate::model::{modes_overlap, Device, Object, Value};
+use crate::model::{Device, Object, Value, modes_overlap};
 use crate::types::{Access, DataType, ObjectKind, Sub0};
 use std::collections::BTreeMap;
 
@@ -12,7 +12,9 @@ pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
             // Two generated objects collide only through a repeated PDO: `pdo-duplicate` says so.
             if modes_overlap(&a.modes, &b.modes) && !(a.generated && b.generated) {
                 let what = if b.generated { " (generated from `pdo:`; do not list PDO parameter objects in `objects:`)" } else { "" };
-                diags.push(Diagnostic::error("od-duplicate", b.span, format!("object {} is defined twice{what}", hex4(a.index))).note_at(a.span, "first defined here"));
+                diags.push(
+                    Diagnostic::error("od-duplicate", b.span, format!("object {} is defined twice{what}", hex4(a.index))).note_at(a.span, "first defined here"),
+                );
             }
         }
         let mut seen: BTreeMap<u8, usize> = BTreeMap::new();
@@ -20,7 +22,10 @@ pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
             if let Some(&first) = seen.get(&e.sub) {
                 let prev = &a.entries[first];
                 if modes_overlap(&prev.modes, &e.modes) {
-                    diags.push(Diagnostic::error("od-duplicate", e.spans.at, format!("sub-index {} of object {} is defined twice", e.sub, hex4(a.index))).note_at(prev.spans.at, "first defined here"));
+                    diags.push(
+                        Diagnostic::error("od-duplicate", e.spans.at, format!("sub-index {} of object {} is defined twice", e.sub, hex4(a.index)))
+                            .note_at(prev.spans.at, "first defined here"),
+                    );
                 }
             } else {
                 seen.insert(e.sub, k);
@@ -38,9 +43,13 @@ pub fn ident_collision(d: &Device, diags: &mut Diagnostics) {
         for (i, b) in objs.iter().enumerate() {
             if let Some(a) = objs[..i].iter().find(|a| a.index != b.index && modes_overlap(&a.modes, &b.modes)) {
                 diags.push(
-                    Diagnostic::error("od-ident-collision", b.span, format!("objects {} and {} both become the identifier `{ident}`", hex4(a.index), hex4(b.index)))
-                        .note_at(a.span, "the other object")
-                        .note("give one of them an `ident:`"),
+                    Diagnostic::error(
+                        "od-ident-collision",
+                        b.span,
+                        format!("objects {} and {} both become the identifier `{ident}`", hex4(a.index), hex4(b.index)),
+                    )
+                    .note_at(a.span, "the other object")
+                    .note("give one of them an `ident:`"),
                 );
             }
         }
@@ -50,7 +59,12 @@ pub fn ident_collision(d: &Device, diags: &mut Diagnostics) {
         for e in &o.entries {
             match seen.get(e.ident.as_str()) {
                 Some(&sub) if sub != e.sub => diags.push(
-                    Diagnostic::error("od-ident-collision", e.spans.at, format!("subs {sub} and {} of object {} both become the identifier `{}`", e.sub, hex4(o.index), e.ident)).note("give one of them an `ident:`"),
+                    Diagnostic::error(
+                        "od-ident-collision",
+                        e.spans.at,
+                        format!("subs {sub} and {} of object {} both become the identifier `{}`", e.sub, hex4(o.index), e.ident),
+                    )
+                    .note("give one of them an `ident:`"),
                 ),
                 _ => {
                     seen.insert(e.ident.as_str(), e.sub);
@@ -75,7 +89,10 @@ fn index_area(index: u16) -> Option<&'static str> {
 pub fn index_range(d: &Device, diags: &mut Diagnostics) {
     for o in &d.objects {
         if index_area(o.index).is_none() {
-            diags.push(Diagnostic::error("od-index-range", o.span, format!("index {} is reserved by CiA 301", hex4(o.index))).note("objects live in 0x0001-0x025F, 0x1000-0x1FFF, 0x2000-0x5FFF, 0x6000-0x9FFF or 0xA000-0xBFFF"));
+            diags.push(
+                Diagnostic::error("od-index-range", o.span, format!("index {} is reserved by CiA 301", hex4(o.index)))
+                    .note("objects live in 0x0001-0x025F, 0x1000-0x1FFF, 0x2000-0x5FFF, 0x6000-0x9FFF or 0xA000-0xBFFF"),
+            );
         }
     }
 }
@@ -88,10 +105,10 @@ pub fn mandatory(d: &Device, diags: &mut Diagnostics) {
                 diags.push(Diagnostic::error("od-mandatory", d.identity.span, format!("mandatory object {} ({name}) is missing{suffix}", hex4(index))));
             }
         }
-        if let Some(id) = d.object(0x1018, mode) {
-            if id.entry(1).is_none() {
-                diags.push(Diagnostic::error("od-mandatory", id.span, format!("1018 must have sub-index 1 (vendor ID){suffix}")));
-            }
+        if let Some(id) = d.object(0x1018, mode)
+            && id.entry(1).is_none()
+        {
+            diags.push(Diagnostic::error("od-mandatory", id.span, format!("1018 must have sub-index 1 (vendor ID){suffix}")));
         }
     }
 }
@@ -110,16 +127,27 @@ pub fn sub0(d: &Device, diags: &mut Diagnostics) {
         match o.sub0 {
             Sub0::Highest => {
                 if !matches!(e.access, Access::Ro | Access::Const) {
-                    diags.push(Diagnostic::error("od-sub0", e.spans.access, format!("sub 0 of {} must be read-only, not {}", hex4(o.index), e.access)).note("if sub 0 counts valid entries (like 1003), set `sub0: count` on the object"));
+                    diags.push(
+                        Diagnostic::error("od-sub0", e.spans.access, format!("sub 0 of {} must be read-only, not {}", hex4(o.index), e.access))
+                            .note("if sub 0 counts valid entries (like 1003), set `sub0: count` on the object"),
+                    );
                 }
                 if value != Some(highest) {
                     let found = value.map_or("no default".to_string(), |v| format!("{v}"));
-                    diags.push(Diagnostic::error("od-sub0", e.spans.default, format!("sub 0 of {} must be {highest} (the highest sub-index), found {found}", hex4(o.index))));
+                    diags.push(Diagnostic::error(
+                        "od-sub0",
+                        e.spans.default,
+                        format!("sub 0 of {} must be {highest} (the highest sub-index), found {found}", hex4(o.index)),
+                    ));
                 }
             }
             Sub0::Count => {
                 if value.is_some_and(|v| v > highest) {
-                    diags.push(Diagnostic::error("od-sub0", e.spans.default, format!("sub 0 of {} counts entries but exceeds the highest sub-index {highest}", hex4(o.index))));
+                    diags.push(Diagnostic::error(
+                        "od-sub0",
+                        e.spans.default,
+                        format!("sub 0 of {} counts entries but exceeds the highest sub-index {highest}", hex4(o.index)),
+                    ));
                 }
             }
         }
@@ -132,8 +160,12 @@ pub fn array_uniform(d: &Device, diags: &mut Diagnostics) {
         let Some(first) = subs.next() else { continue };
         for e in subs.filter(|e| e.data_type != first.data_type) {
             diags.push(
-                Diagnostic::error("od-array-uniform", e.spans.data_type, format!("ARRAY {} mixes {} (sub {}) and {} (sub {})", hex4(o.index), first.data_type, first.sub, e.data_type, e.sub))
-                    .note("all elements of an ARRAY share one type; use `kind: record` for mixed types"),
+                Diagnostic::error(
+                    "od-array-uniform",
+                    e.spans.data_type,
+                    format!("ARRAY {} mixes {} (sub {}) and {} (sub {})", hex4(o.index), first.data_type, first.sub, e.data_type, e.sub),
+                )
+                .note("all elements of an ARRAY share one type; use `kind: record` for mixed types"),
             );
         }
     }
@@ -159,7 +191,17 @@ pub fn default_range(d: &Device, diags: &mut Diagnostics) {
                         let Some(v) = default.int_for(n).map(i128::from) else { continue };
                         if !(lo..=hi).contains(&v) {
                             let at = if expr.uses_node_id() { format!(" for node ID {n}") } else { String::new() };
-                            diags.push(Diagnostic::error("od-default-range", e.spans.default, format!("default {v:#X}{at} of {}.{} lies outside {lo:#X}..={hi:#X} ({}{})", hex4(o.index), e.sub, e.data_type, if e.low.is_some() || e.high.is_some() { " within its limits" } else { "" })));
+                            diags.push(Diagnostic::error(
+                                "od-default-range",
+                                e.spans.default,
+                                format!(
+                                    "default {v:#X}{at} of {}.{} lies outside {lo:#X}..={hi:#X} ({}{})",
+                                    hex4(o.index),
+                                    e.sub,
+                                    e.data_type,
+                                    if e.low.is_some() || e.high.is_some() { " within its limits" } else { "" }
+                                ),
+                            ));
                             break;
                         }
                     }
@@ -168,16 +210,28 @@ pub fn default_range(d: &Device, diags: &mut Diagnostics) {
                     if let Some(max) = e.length {
                         let len = u32::try_from(s.len()).unwrap_or(u32::MAX);
                         if len > max {
-                            diags.push(Diagnostic::error("od-default-range", e.spans.default, format!("default of {}.{} is {len} bytes long; its `length` is {max}", hex4(o.index), e.sub)));
+                            diags.push(Diagnostic::error(
+                                "od-default-range",
+                                e.spans.default,
+                                format!("default of {}.{} is {len} bytes long; its `length` is {max}", hex4(o.index), e.sub),
+                            ));
                         }
                     }
                     if e.data_type == DataType::VisibleString && !s.bytes().all(|b| (0x20..=0x7E).contains(&b)) {
-                        diags.push(Diagnostic::error("od-default-range", e.spans.default, format!("default of {}.{} has characters outside VISIBLE_STRING (0x20..0x7E)", hex4(o.index), e.sub)));
+                        diags.push(Diagnostic::error(
+                            "od-default-range",
+                            e.spans.default,
+                            format!("default of {}.{} has characters outside VISIBLE_STRING (0x20..0x7E)", hex4(o.index), e.sub),
+                        ));
                     }
                 }
                 Value::Real(x) => {
                     if e.data_type == DataType::Real32 && x.is_finite() && x.abs() > f64::from(f32::MAX) {
-                        diags.push(Diagnostic::error("od-default-range", e.spans.default, format!("default {x} of {}.{} does not fit REAL32", hex4(o.index), e.sub)));
+                        diags.push(Diagnostic::error(
+                            "od-default-range",
+                            e.spans.default,
+                            format!("default {x} of {}.{} does not fit REAL32", hex4(o.index), e.sub),
+                        ));
                     }
                 }
             }
@@ -193,13 +247,20 @@ pub fn limits(d: &Device, diags: &mut Diagnostics) {
             let (lo, hi) = (lim(&e.low), lim(&e.high));
             for (v, span, what) in [(lo, e.spans.low, "low"), (hi, e.spans.high, "high")] {
                 if let Some(v) = v.filter(|v| !(tlo..=thi).contains(v)) {
-                    diags.push(Diagnostic::error("od-limits", span, format!("{what} limit {v:#X} of {}.{} does not fit {}", hex4(o.index), e.sub, e.data_type)));
+                    diags.push(Diagnostic::error(
+                        "od-limits",
+                        span,
+                        format!("{what} limit {v:#X} of {}.{} does not fit {}", hex4(o.index), e.sub, e.data_type),
+                    ));
                 }
             }
-            if let (Some(lo), Some(hi)) = (lo, hi) {
-                if lo > hi {
-                    diags.push(Diagnostic::error("od-limits", e.spans.low, format!("low limit {lo:#X} of {}.{} exceeds its high limit {hi:#X}", hex4(o.index), e.sub)).note_at(e.spans.high, "high limit"));
-                }
+            if let (Some(lo), Some(hi)) = (lo, hi)
+                && lo > hi
+            {
+                diags.push(
+                    Diagnostic::error("od-limits", e.spans.low, format!("low limit {lo:#X} of {}.{} exceeds its high limit {hi:#X}", hex4(o.index), e.sub))
+                        .note_at(e.spans.high, "high limit"),
+                );
             }
         }
     }
@@ -210,19 +271,29 @@ pub fn identity(d: &Device, diags: &mut Diagnostics) {
     for o in d.objects.iter().filter(|o| o.index == 0x1018) {
         for (sub, want, what) in [(1, id.vendor_id, "vendor_id"), (2, id.product_code, "product_code"), (3, id.revision, "revision")] {
             let Some(e) = o.entry(sub) else { continue };
-            if let Some(v) = e.default.as_ref().and_then(|v| v.int_for(1)) {
-                if v != i64::from(want) {
-                    diags.push(Diagnostic::error("od-identity", e.spans.default, format!("1018.{sub} defaults to {v:#010X} but `device.{what}` is {want:#010X}")).note_at(id.span, "device identity"));
-                }
+            if let Some(v) = e.default.as_ref().and_then(|v| v.int_for(1))
+                && v != i64::from(want)
+            {
+                diags.push(
+                    Diagnostic::error("od-identity", e.spans.default, format!("1018.{sub} defaults to {v:#010X} but `device.{what}` is {want:#010X}"))
+                        .note_at(id.span, "device identity"),
+                );
             }
         }
     }
     for o in d.objects.iter().filter(|o| o.index == 0x1000) {
         let Some(e) = o.entry(0) else { continue };
-        if let Some(v) = e.default.as_ref().and_then(|v| v.int_for(1)) {
-            if v & 0xFFFF != i64::from(id.profile) {
-                diags.push(Diagnostic::error("od-identity", e.spans.default, format!("1000 defaults to {v:#010X}, whose low 16 bits should be the profile {}", id.profile)).note_at(id.span, "device identity"));
-            }
+        if let Some(v) = e.default.as_ref().and_then(|v| v.int_for(1))
+            && v & 0xFFFF != i64::from(id.profile)
+        {
+            diags.push(
+                Diagnostic::error(
+                    "od-identity",
+                    e.spans.default,
+                    format!("1000 defaults to {v:#010X}, whose low 16 bits should be the profile {}", id.profile),
+                )
+                .note_at(id.span, "device identity"),
+            );
         }
     }
 }
@@ -237,9 +308,13 @@ pub fn redundant_pair(d: &Device, diags: &mut Diagnostics) {
         let shape = |o: &Object| o.entries.iter().map(|e| (e.sub, e.data_type, e.access, e.default.clone())).collect::<Vec<_>>();
         if a.kind != b.kind || shape(a) != shape(b) {
             diags.push(
-                Diagnostic::error("redundant-pair", pair.span, format!("{} and {} must have the same subs, types, access and defaults to be compared", hex4(a.index), hex4(b.index)))
-                    .note_at(a.span, "primary")
-                    .note_at(b.span, "shadow"),
+                Diagnostic::error(
+                    "redundant-pair",
+                    pair.span,
+                    format!("{} and {} must have the same subs, types, access and defaults to be compared", hex4(a.index), hex4(b.index)),
+                )
+                .note_at(a.span, "primary")
+                .note_at(b.span, "shadow"),
             );
         }
     }

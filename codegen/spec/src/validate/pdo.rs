@@ -2,7 +2,7 @@
 
 use super::hex4;
 use crate::diag::{Diagnostic, Diagnostics};
-use crate::model::{in_mode, modes_overlap, Device, Entry, Mapping, Pdo, PdoDir};
+use crate::model::{Device, Entry, Mapping, Pdo, PdoDir, in_mode, modes_overlap};
 
 /// Calls `f` for each mapping of each PDO, with the mapped entry as seen in each mode.
 fn each_mapping(d: &Device, mut f: impl FnMut(&Pdo, &Mapping, Option<&Entry>, Option<&str>)) {
@@ -29,7 +29,9 @@ pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
     for (i, a) in d.pdo.pdos.iter().enumerate() {
         for b in &d.pdo.pdos[i + 1..] {
             if a.dir == b.dir && a.number == b.number && modes_overlap(&a.modes, &b.modes) {
-                diags.push(Diagnostic::error("pdo-duplicate", b.span, format!("{}{} is defined twice", b.dir.name(), b.number)).note_at(a.span, "first defined here"));
+                diags.push(
+                    Diagnostic::error("pdo-duplicate", b.span, format!("{}{} is defined twice", b.dir.name(), b.number)).note_at(a.span, "first defined here"),
+                );
             }
         }
     }
@@ -38,7 +40,11 @@ pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
 pub fn mapping_target(d: &Device, diags: &mut Diagnostics) {
     each_mapping(d, |pdo, m, entry, mode| {
         if entry.is_none() && !is_dummy(m) {
-            diags.push(Diagnostic::error("pdo-mapping-target", m.span, format!("{}{} maps {}.{}, which does not exist{}", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, in_mode_text(mode))));
+            diags.push(Diagnostic::error(
+                "pdo-mapping-target",
+                m.span,
+                format!("{}{} maps {}.{}, which does not exist{}", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, in_mode_text(mode)),
+            ));
         }
     });
 }
@@ -47,7 +53,12 @@ pub fn mapping_mappable(d: &Device, diags: &mut Diagnostics) {
     each_mapping(d, |pdo, m, entry, _| {
         if let Some(e) = entry.filter(|e| !e.pdo_mapping) {
             diags.push(
-                Diagnostic::error("pdo-mapping-mappable", m.span, format!("{}{} maps {}.{} ({}), which is not PDO-mappable", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, e.name)).note_at(e.spans.at, "set `pdo_mapping: true` here if the datasheet allows it"),
+                Diagnostic::error(
+                    "pdo-mapping-mappable",
+                    m.span,
+                    format!("{}{} maps {}.{} ({}), which is not PDO-mappable", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, e.name),
+                )
+                .note_at(e.spans.at, "set `pdo_mapping: true` here if the datasheet allows it"),
             );
         }
     });
@@ -61,7 +72,11 @@ pub fn mapping_length(d: &Device, diags: &mut Diagnostics) {
             None => None,
         };
         if let Some(bits) = want.filter(|&b| b != u32::from(m.bits)) {
-            diags.push(Diagnostic::error("pdo-mapping-length", m.span, format!("{}{} maps {}.{} with {} bits, but the entry is {bits} bits", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, m.bits)));
+            diags.push(Diagnostic::error(
+                "pdo-mapping-length",
+                m.span,
+                format!("{}{} maps {}.{} with {} bits, but the entry is {bits} bits", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, m.bits),
+            ));
         }
     });
 }
@@ -74,7 +89,14 @@ pub fn mapping_access(d: &Device, diags: &mut Diagnostics) {
             PdoDir::Tx => (!e.access.readable()).then_some("a TPDO reads what it maps, but the entry is not readable"),
         };
         if let Some(why) = bad {
-            diags.push(Diagnostic::error("pdo-mapping-access", m.span, format!("{}{} maps {}.{} with access {}: {why}", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, e.access)).note_at(e.spans.access, "access declared here"));
+            diags.push(
+                Diagnostic::error(
+                    "pdo-mapping-access",
+                    m.span,
+                    format!("{}{} maps {}.{} with access {}: {why}", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, e.access),
+                )
+                .note_at(e.spans.access, "access declared here"),
+            );
         }
     });
 }
@@ -83,7 +105,11 @@ pub fn mapping_size(d: &Device, diags: &mut Diagnostics) {
     for pdo in &d.pdo.pdos {
         let total: u32 = pdo.map.iter().map(|m| u32::from(m.bits)).sum();
         if total > 64 {
-            diags.push(Diagnostic::error("pdo-mapping-size", pdo.span, format!("{}{} maps {total} bits; a CAN frame carries at most 64", pdo.dir.name(), pdo.number)));
+            diags.push(Diagnostic::error(
+                "pdo-mapping-size",
+                pdo.span,
+                format!("{}{} maps {total} bits; a CAN frame carries at most 64", pdo.dir.name(), pdo.number),
+            ));
         }
         let max = match pdo.dir {
             PdoDir::Rx => d.pdo.rpdo.as_ref(),
@@ -91,7 +117,11 @@ pub fn mapping_size(d: &Device, diags: &mut Diagnostics) {
         }
         .map_or(0, |s| s.max_mapped);
         if pdo.map.len() > usize::from(max) {
-            diags.push(Diagnostic::error("pdo-mapping-size", pdo.span, format!("{}{} maps {} entries but `max_mapped` is {max}", pdo.dir.name(), pdo.number, pdo.map.len())));
+            diags.push(Diagnostic::error(
+                "pdo-mapping-size",
+                pdo.span,
+                format!("{}{} maps {} entries but `max_mapped` is {max}", pdo.dir.name(), pdo.number, pdo.map.len()),
+            ));
         }
     }
 }
@@ -106,7 +136,7 @@ pub fn cob_id(d: &Device, diags: &mut Diagnostics) {
     const EXTENDED: i64 = 1 << 29;
     for pdo in &d.pdo.pdos {
         let v = pdo.cob_id.eval(&Default::default(), Some(1)).unwrap_or(0);
-        if v < 0 || v > 0xFFFF_FFFF {
+        if !(0..=0xFFFF_FFFF).contains(&v) {
             diags.push(Diagnostic::error("pdo-cob-id", pdo.cob_id_span, format!("COB-ID of {}{} does not fit UNSIGNED32", pdo.dir.name(), pdo.number)));
             continue;
         }
@@ -114,7 +144,16 @@ pub fn cob_id(d: &Device, diags: &mut Diagnostics) {
             let id = pdo.cob_id.eval(&Default::default(), Some(node)).unwrap_or(0);
             let can_id = id & 0x1FFF_FFFF;
             if id & INVALID == 0 && id & EXTENDED == 0 && (can_id > 0x7FF || restricted(can_id)) {
-                diags.push(Diagnostic::error("pdo-cob-id", pdo.cob_id_span, format!("{}{} uses CAN-ID {can_id:#05X} for node ID {node}, which is {}", pdo.dir.name(), pdo.number, if can_id > 0x7FF { "not an 11-bit identifier" } else { "restricted by CiA 301" })));
+                diags.push(Diagnostic::error(
+                    "pdo-cob-id",
+                    pdo.cob_id_span,
+                    format!(
+                        "{}{} uses CAN-ID {can_id:#05X} for node ID {node}, which is {}",
+                        pdo.dir.name(),
+                        pdo.number,
+                        if can_id > 0x7FF { "not an 11-bit identifier" } else { "restricted by CiA 301" }
+                    ),
+                ));
                 break;
             }
         }
@@ -130,7 +169,21 @@ pub fn cob_id(d: &Device, diags: &mut Diagnostics) {
                 x & INVALID == 0 && y & INVALID == 0 && x & 0x3FFF_FFFF == y & 0x3FFF_FFFF
             });
             if let Some(n) = clash {
-                diags.push(Diagnostic::error("pdo-cob-id", b.cob_id_span, format!("{}{} and {}{} both use COB-ID {:#X} for node ID {n}", a.dir.name(), a.number, b.dir.name(), b.number, b.cob_id.eval(&Default::default(), Some(n)).unwrap_or(0))).note_at(a.cob_id_span, "the other PDO"));
+                diags.push(
+                    Diagnostic::error(
+                        "pdo-cob-id",
+                        b.cob_id_span,
+                        format!(
+                            "{}{} and {}{} both use COB-ID {:#X} for node ID {n}",
+                            a.dir.name(),
+                            a.number,
+                            b.dir.name(),
+                            b.number,
+                            b.cob_id.eval(&Default::default(), Some(n)).unwrap_or(0)
+                        ),
+                    )
+                    .note_at(a.cob_id_span, "the other PDO"),
+                );
             }
         }
     }
@@ -145,7 +198,11 @@ pub fn transmission_type(d: &Device, diags: &mut Diagnostics) {
             _ => None,
         };
         if let Some(why) = why {
-            diags.push(Diagnostic::error("pdo-transmission-type", pdo.transmission_type_span, format!("{}{} has transmission type {t}: {why}", pdo.dir.name(), pdo.number)));
+            diags.push(Diagnostic::error(
+                "pdo-transmission-type",
+                pdo.transmission_type_span,
+                format!("{}{} has transmission type {t}: {why}", pdo.dir.name(), pdo.number),
+            ));
         }
     }
 }

@@ -2,7 +2,7 @@
 
 use crate::diag::{Diagnostic, Diagnostics};
 use crate::frame;
-use crate::model::{modes_overlap, Command, Device, ExampleValue, FieldType, Framing};
+use crate::model::{Command, Device, ExampleValue, FieldType, Framing, modes_overlap};
 use std::collections::BTreeMap;
 
 fn commands(d: &Device) -> &[Command] {
@@ -28,8 +28,12 @@ pub fn code_collision(d: &Device, diags: &mut Diagnostics) {
             let codes_b = b.codes();
             if let Some(code) = a.codes().into_iter().find(|c| codes_b.contains(c)) {
                 diags.push(
-                    Diagnostic::error("serial-code-collision", b.code_span, format!("`{}` and `{}` both use code {code:#04X} in direction {}", a.name, b.name, a.direction.name()))
-                        .note_at(a.code_span, format!("`{}` uses {}", a.name, codes_text(a))),
+                    Diagnostic::error(
+                        "serial-code-collision",
+                        b.code_span,
+                        format!("`{}` and `{}` both use code {code:#04X} in direction {}", a.name, b.name, a.direction.name()),
+                    )
+                    .note_at(a.code_span, format!("`{}` uses {}", a.name, codes_text(a))),
                 );
             }
         }
@@ -62,7 +66,14 @@ pub fn length(d: &Device, diags: &mut Diagnostics) {
         if let Some(code) = c.length_code {
             match serial.framing {
                 Framing::LengthByte { extension_threshold, .. } if code >= u32::from(extension_threshold) => {}
-                Framing::LengthByte { extension_threshold, .. } => diags.push(Diagnostic::error("serial-length", c.span, format!("`length_code` {code:#04X} of `{}` is below the extension threshold {extension_threshold:#04X}; use `length` for real lengths", c.name))),
+                Framing::LengthByte { extension_threshold, .. } => diags.push(Diagnostic::error(
+                    "serial-length",
+                    c.span,
+                    format!(
+                        "`length_code` {code:#04X} of `{}` is below the extension threshold {extension_threshold:#04X}; use `length` for real lengths",
+                        c.name
+                    ),
+                )),
                 _ => diags.push(Diagnostic::error("serial-length", c.span, format!("`length_code` of `{}` only applies to `length_byte` framing", c.name))),
             }
         }
@@ -88,16 +99,31 @@ pub fn field_layout(d: &Device, diags: &mut Diagnostics) {
                 let (a0, a1) = (g.at, g.at + g.ty.fixed_size().max(1));
                 let (b0, b1) = (f.at, f.at + f.ty.fixed_size().max(1));
                 if a0 < b1 && b0 < a1 {
-                    diags.push(Diagnostic::error("serial-field-layout", f.span, format!("field `{}` (bytes {b0}..{b1}) overlaps `{}` (bytes {a0}..{a1}) in `{}`", f.name, g.name, c.name)).note_at(g.span, "the other field"));
+                    diags.push(
+                        Diagnostic::error(
+                            "serial-field-layout",
+                            f.span,
+                            format!("field `{}` (bytes {b0}..{b1}) overlaps `{}` (bytes {a0}..{a1}) in `{}`", f.name, g.name, c.name),
+                        )
+                        .note_at(g.span, "the other field"),
+                    );
                 }
             }
             let end = f.at + f.ty.fixed_size();
             if end > c.length.1 {
-                diags.push(Diagnostic::error("serial-field-layout", f.span, format!("field `{}` ends at byte {end}, past the {} data bytes of `{}`", f.name, c.length.1, c.name)));
+                diags.push(Diagnostic::error(
+                    "serial-field-layout",
+                    f.span,
+                    format!("field `{}` ends at byte {end}, past the {} data bytes of `{}`", f.name, c.length.1, c.name),
+                ));
             }
         }
         if c.length.1 > frame_max && c.length_code.is_none() {
-            diags.push(Diagnostic::error("serial-field-layout", c.length_span, format!("`{}` carries up to {} data bytes; {} framing allows at most {frame_max}", c.name, c.length.1, serial.framing.kind())));
+            diags.push(Diagnostic::error(
+                "serial-field-layout",
+                c.length_span,
+                format!("`{}` carries up to {} data bytes; {} framing allows at most {frame_max}", c.name, c.length.1, serial.framing.kind()),
+            ));
         }
     }
 }
@@ -129,8 +155,16 @@ pub fn example(d: &Device, diags: &mut Diagnostics) {
             };
             for (name, (want, at)) in &ex.fields {
                 match values.get(name) {
-                    None => diags.push(Diagnostic::error("serial-example", *at, format!("example of `{}` names field `{name}`, which the command does not have", c.name))),
-                    Some(got) if !same(got, want) => diags.push(Diagnostic::error("serial-example", *at, format!("example of `{}`: field `{name}` decodes as {} but the example says {}", c.name, show(got), show(want)))),
+                    None => diags.push(Diagnostic::error(
+                        "serial-example",
+                        *at,
+                        format!("example of `{}` names field `{name}`, which the command does not have", c.name),
+                    )),
+                    Some(got) if !same(got, want) => diags.push(Diagnostic::error(
+                        "serial-example",
+                        *at,
+                        format!("example of `{}`: field `{name}` decodes as {} but the example says {}", c.name, show(got), show(want)),
+                    )),
                     Some(_) => {}
                 }
             }
@@ -158,14 +192,21 @@ pub fn reply(d: &Device, diags: &mut Diagnostics) {
         if let Some(r) = &c.reply {
             match cmds.iter().find(|o| &o.name == r) {
                 None => diags.push(Diagnostic::error("serial-reply", c.reply_span, format!("`{}` is answered by `{r}`, which is not a command", c.name))),
-                Some(o) if o.direction == c.direction => diags.push(Diagnostic::error("serial-reply", c.reply_span, format!("`{}` and its reply `{r}` travel in the same direction", c.name)).note_at(o.span, "the reply")),
+                Some(o) if o.direction == c.direction => diags.push(
+                    Diagnostic::error("serial-reply", c.reply_span, format!("`{}` and its reply `{r}` travel in the same direction", c.name))
+                        .note_at(o.span, "the reply"),
+                ),
                 Some(_) => {}
             }
         }
-        if let Some(ack) = &c.ack {
-            if !c.fields.iter().any(|f| f.name == ack.field) {
-                diags.push(Diagnostic::error("serial-reply", ack.span, format!("`ack` of `{}` names field `{}`, which the command does not have", c.name, ack.field)));
-            }
+        if let Some(ack) = &c.ack
+            && !c.fields.iter().any(|f| f.name == ack.field)
+        {
+            diags.push(Diagnostic::error(
+                "serial-reply",
+                ack.span,
+                format!("`ack` of `{}` names field `{}`, which the command does not have", c.name, ack.field),
+            ));
         }
     }
 }
@@ -175,7 +216,11 @@ pub fn crc(d: &Device, diags: &mut Diagnostics) {
     if let Framing::StartLengthCrc { crc, .. } = &serial.framing {
         let got = crc.compute(b"123456789");
         if got != crc.check {
-            diags.push(Diagnostic::error("serial-crc", crc.check_span, format!("these CRC parameters give {got:#X} over \"123456789\", not the stated check value {:#X}", crc.check)));
+            diags.push(Diagnostic::error(
+                "serial-crc",
+                crc.check_span,
+                format!("these CRC parameters give {got:#X} over \"123456789\", not the stated check value {:#X}", crc.check),
+            ));
         }
         if !crc.covers_payload {
             diags.push(Diagnostic::error("serial-crc", serial.framing_span, "the CRC must cover the payload"));

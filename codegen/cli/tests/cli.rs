@@ -1,0 +1,92 @@
+//! The `coforge` binary as a user runs it: exit codes, messages, files written.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn coforge(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_coforge")).args(args).current_dir(repo()).output().expect("coforge runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("coforge-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir.join(name)
+}
+
+#[test]
+fn check_passes_on_the_four_specs() {
+    let o = coforge(&["check", "spec/canopenia.yaml", "spec/co401gw1.yaml", "spec/co401memory1.yaml", "spec/cr3101.yaml"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(out.lines().filter(|l| l.contains(": ok (")).count(), 4, "{out}");
+}
+
+#[test]
+fn yaml_errors_are_reported_cleanly_with_a_position() {
+    for (fixture, needle) in [("yaml-syntax", "mismatched bracket"), ("yaml-unknown-key", "unknown field `acess`")] {
+        let path = format!("codegen/spec/tests/fixtures/invalid/{fixture}.yaml");
+        let o = coforge(&["check", &path]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{fixture}: exit 1\n{err}");
+        assert!(err.contains("error[yaml]") && err.contains(needle), "{fixture}: {err}");
+        assert!(err.contains(&format!("--> {path}:")), "{fixture}: file:line:col\n{err}");
+        assert!(!err.contains("panicked") && !err.contains("backtrace"), "{fixture}: no panic\n{err}");
+    }
+}
+
+#[test]
+fn a_missing_file_is_an_error_not_a_panic() {
+    let o = coforge(&["check", "spec/does-not-exist.yaml"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("cannot read spec/does-not-exist.yaml"), "{}", stderr(&o));
+}
+
+#[test]
+fn eds_needs_a_mode_for_devices_with_modes_and_writes_the_file() {
+    let o = coforge(&["eds", "spec/co401gw1.yaml"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("choose one with --mode"), "{}", stderr(&o));
+    let out = scratch("gw1.eds");
+    let o = coforge(&["eds", "spec/co401gw1.yaml", "--mode", "mixed", "-o", out.to_str().unwrap_or_default()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let eds = std::fs::read_to_string(&out).unwrap_or_default();
+    assert!(eds.starts_with("[FileInfo]") && eds.contains("[1018sub1]") && eds.contains("VendorNumber=0x58"), "{eds}");
+}
+
+#[test]
+fn docs_render_the_object_dictionary() {
+    let o = coforge(&["docs", "spec/co401memory1.yaml"]);
+    assert!(o.status.success());
+    let md = String::from_utf8_lossy(&o.stdout);
+    assert!(md.contains("## Object dictionary") && md.contains("| 503F |") && md.contains("## Errata"), "{md}");
+}
+
+#[test]
+fn fmt_check_reports_and_fmt_repairs_layout() {
+    let original = std::fs::read_to_string(repo().join("spec/cr3101.yaml")).unwrap_or_default();
+    let messy = scratch("messy.yaml");
+    // Same data, different layout: no blank lines between sections, extra spaces after dashes.
+    let lines: Vec<&str> = original.lines().collect();
+    let messy_text: Vec<String> = lines
+        .iter()
+        .enumerate()
+        .filter(|(i, l)| !(l.is_empty() && lines.get(i + 1).is_some_and(|n| !n.starts_with(' '))))
+        .map(|(_, l)| l.replacen("- { ", "-   {  ", 1))
+        .collect();
+    std::fs::write(&messy, messy_text.join("\n") + "\n").expect("write");
+    let path = messy.to_str().unwrap_or_default();
+    let o = coforge(&["fmt", "--check", path]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("first difference at line"), "{}", stderr(&o));
+    assert!(coforge(&["fmt", path]).status.success());
+    assert_eq!(std::fs::read_to_string(&messy).unwrap_or_default(), original);
+    assert!(coforge(&["fmt", "--check", "spec/cr3101.yaml"]).status.success());
+}

@@ -1,0 +1,84 @@
+//! Installs what the build and the tests need, saying what and why before doing it.
+
+use crate::{Result, root, run};
+use std::path::PathBuf;
+use std::process::Command;
+
+/// The targets `rust-toolchain.toml` lists, so that one file stays the source of truth.
+fn toolchain_list(key: &str) -> Vec<String> {
+    let text = std::fs::read_to_string(root().join("rust-toolchain.toml")).unwrap_or_default();
+    text.lines()
+        .find_map(|l| l.trim().strip_prefix(key).and_then(|r| r.trim().strip_prefix('=')))
+        .map(|list| list.trim().trim_matches(['[', ']']).split(',').map(|t| t.trim().trim_matches('"').to_string()).filter(|t| !t.is_empty()).collect())
+        .unwrap_or_default()
+}
+
+fn output(cmd: &mut Command) -> Option<String> {
+    cmd.output().ok().filter(|o| o.status.success()).map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
+}
+
+pub fn rust_targets() -> Result {
+    let installed = output(Command::new("rustup").args(["target", "list", "--installed"]).current_dir(root()))
+        .ok_or("rustup is needed to manage targets (https://rustup.rs)")?;
+    for target in toolchain_list("targets") {
+        if !installed.lines().any(|l| l.trim() == target) {
+            println!("xtask: installing Rust target {target} (listed in rust-toolchain.toml, missing here)");
+            run(Command::new("rustup").args(["target", "add", &target]))?;
+        }
+    }
+    Ok(())
+}
+
+pub fn rust_components() -> Result {
+    let installed = output(Command::new("rustup").args(["component", "list", "--installed"]).current_dir(root())).unwrap_or_default();
+    for component in toolchain_list("components") {
+        if !installed.lines().any(|l| l.trim().starts_with(&format!("{component}-")) || l.trim() == component) {
+            println!("xtask: installing Rust component {component} (listed in rust-toolchain.toml, missing here)");
+            run(Command::new("rustup").args(["component", "add", &component]))?;
+        }
+    }
+    Ok(())
+}
+
+fn apt_install(packages: &[&str], why: &str) -> Result {
+    println!("xtask: installing Debian packages {} ({why})", packages.join(" "));
+    let sudo = output(Command::new("id").arg("-u")).is_some_and(|u| u.trim() != "0");
+    let apt = |args: &[&str]| {
+        let mut c = if sudo { Command::new("sudo") } else { Command::new("apt-get") };
+        if sudo {
+            c.arg("apt-get");
+        }
+        c.args(args).env("DEBIAN_FRONTEND", "noninteractive");
+        c
+    };
+    run(&mut apt(&["update", "-q"]))?;
+    let mut install = apt(&["install", "-y", "-q"]);
+    install.args(packages);
+    run(&mut install)
+}
+
+/// `.venv` with the Python test peers from `tests/python/requirements.txt`.
+pub fn python_venv() -> Result<PathBuf> {
+    let venv = root().join(".venv");
+    let python = venv.join("bin/python");
+    if !python.exists() {
+        if output(Command::new("python3").arg("--version")).is_none() {
+            apt_install(&["python3", "python3-venv"], "Python runs the interoperability tests")?;
+        }
+        println!("xtask: creating Python venv {} for the test peers", venv.display());
+        if run(Command::new("python3").args(["-m", "venv"]).arg(&venv)).is_err() {
+            apt_install(&["python3-venv"], "the venv module is missing")?;
+            run(Command::new("python3").args(["-m", "venv", "--clear"]).arg(&venv))?;
+        }
+    }
+    let requirements = root().join("tests/python/requirements.txt");
+    let wanted = std::fs::read_to_string(&requirements).map_err(|e| format!("cannot read {}: {e}", requirements.display()))?;
+    let stamp = venv.join(".coforge-requirements");
+    if std::fs::read_to_string(&stamp).ok().as_deref() != Some(wanted.as_str()) {
+        let names: Vec<&str> = wanted.lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#')).collect();
+        println!("xtask: installing Python test peers into .venv: {}", names.join(" "));
+        run(Command::new(&python).args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check", "-r"]).arg(&requirements))?;
+        std::fs::write(&stamp, &wanted).map_err(|e| format!("cannot write {}: {e}", stamp.display()))?;
+    }
+    Ok(python)
+}
