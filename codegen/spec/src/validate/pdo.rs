@@ -21,6 +21,11 @@ fn is_dummy(m: &Mapping) -> bool {
     (0x0001..=0x0007).contains(&m.index) && m.sub == 0
 }
 
+/// "RPDO1 maps 0x6200.1": how every mapping diagnostic starts.
+fn mapped(pdo: &Pdo, m: &Mapping) -> String {
+    format!("{}{} maps {}.{}", pdo.dir.name(), pdo.number, hex4(m.index), m.sub)
+}
+
 fn in_mode_text(mode: Option<&str>) -> String {
     mode.map(|m| format!(" in mode `{m}`")).unwrap_or_default()
 }
@@ -40,11 +45,7 @@ pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
 pub fn mapping_target(d: &Device, diags: &mut Diagnostics) {
     each_mapping(d, |pdo, m, entry, mode| {
         if entry.is_none() && !is_dummy(m) {
-            diags.push(Diagnostic::error(
-                "pdo-mapping-target",
-                m.span,
-                format!("{}{} maps {}.{}, which does not exist{}", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, in_mode_text(mode)),
-            ));
+            diags.push(Diagnostic::error("pdo-mapping-target", m.span, format!("{}, which does not exist{}", mapped(pdo, m), in_mode_text(mode))));
         }
     });
 }
@@ -53,12 +54,8 @@ pub fn mapping_mappable(d: &Device, diags: &mut Diagnostics) {
     each_mapping(d, |pdo, m, entry, _| {
         if let Some(e) = entry.filter(|e| !e.pdo_mapping) {
             diags.push(
-                Diagnostic::error(
-                    "pdo-mapping-mappable",
-                    m.span,
-                    format!("{}{} maps {}.{} ({}), which is not PDO-mappable", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, e.name),
-                )
-                .note_at(e.spans.at, "set `pdo_mapping: true` here if the datasheet allows it"),
+                Diagnostic::error("pdo-mapping-mappable", m.span, format!("{} ({}), which is not PDO-mappable", mapped(pdo, m), e.name))
+                    .note_at(e.spans.at, "set `pdo_mapping: true` here if the datasheet allows it"),
             );
         }
     });
@@ -72,11 +69,7 @@ pub fn mapping_length(d: &Device, diags: &mut Diagnostics) {
             None => None,
         };
         if let Some(bits) = want.filter(|&b| b != u32::from(m.bits)) {
-            diags.push(Diagnostic::error(
-                "pdo-mapping-length",
-                m.span,
-                format!("{}{} maps {}.{} with {} bits, but the entry is {bits} bits", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, m.bits),
-            ));
+            diags.push(Diagnostic::error("pdo-mapping-length", m.span, format!("{} with {} bits, but the entry is {bits} bits", mapped(pdo, m), m.bits)));
         }
     });
 }
@@ -90,12 +83,8 @@ pub fn mapping_access(d: &Device, diags: &mut Diagnostics) {
         };
         if let Some(why) = bad {
             diags.push(
-                Diagnostic::error(
-                    "pdo-mapping-access",
-                    m.span,
-                    format!("{}{} maps {}.{} with access {}: {why}", pdo.dir.name(), pdo.number, hex4(m.index), m.sub, e.access),
-                )
-                .note_at(e.spans.access, "access declared here"),
+                Diagnostic::error("pdo-mapping-access", m.span, format!("{} with access {}: {why}", mapped(pdo, m), e.access))
+                    .note_at(e.spans.access, "access declared here"),
             );
         }
     });
