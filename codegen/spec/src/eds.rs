@@ -146,7 +146,9 @@ pub fn export(d: &Device, mode: Option<&str>) -> Result<String, ExportError> {
     let objects: Vec<_> = objects_in(d, mode).collect();
     let _ = writeln!(out, "[DummyUsage]");
     for i in 1..=7_u16 {
-        let used = objects.iter().any(|(o, _)| o.index == i);
+        // A dummy is in use if the spec declares it or a default PDO of this mode maps it.
+        let mapped = d.pdo.pdos.iter().filter(|p| in_mode(&p.modes, mode)).any(|p| p.map.iter().any(|m| m.index == i));
+        let used = mapped || objects.iter().any(|(o, _)| o.index == i);
         let _ = writeln!(out, "Dummy{i:04X}={}", u8::from(used));
     }
     let _ = writeln!(out);

@@ -430,7 +430,7 @@ fn object(cx: &mut Cx<'_>, item: &S<raw::Object>, vars: &Vars) -> Option<Object>
     };
     let name = cx.text(name_s, vars)?;
     let ident = match f.ident {
-        Some(i) => i.value.clone(),
+        Some(i) => cx.text(i, vars)?,
         None => snake_case(&name),
     };
     let modes = cx.modes(f.modes, &None);
@@ -572,7 +572,7 @@ fn entry(cx: &mut Cx<'_>, f: raw::EntryFields<'_>, sub: u8, at: Span, vars: &Var
     Some(Entry {
         sub,
         ident: match f.ident {
-            Some(i) => i.value.clone(),
+            Some(i) => cx.text(i, vars)?,
             None => snake_case(&name),
         },
         name,
