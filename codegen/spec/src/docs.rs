@@ -39,7 +39,8 @@ pub fn markdown(d: &Device) -> String {
     if !d.modes.is_empty() {
         let _ = writeln!(out, "## Operating modes\n\n| Mode | Selected by | Description |\n|---|---|---|");
         for m in &d.modes {
-            let mut sel: Vec<String> = m.pins.iter().map(|(p, l)| format!("{p} {l:?}").to_lowercase()).collect();
+            let mut sel: Vec<String> = m.pins.iter().map(|(p, l)| format!("{p} {}", format!("{l:?}").to_lowercase())).collect();
+            sel.extend(m.object.iter().map(|(i, s, v)| format!("{i:04X}.{s} = {v}")));
             sel.extend(m.command.iter().map(|c| format!("command `{c}`")));
             let _ = writeln!(out, "| `{}` | {} | {} |", m.name, sel.join(" + "), cell(&m.description));
         }
@@ -68,13 +69,20 @@ pub fn markdown(d: &Device) -> String {
             } else {
                 e.host_access.name().to_string()
             };
-            let default = e.default.as_ref().map(|v| format!("`{}`", cell(&eds_value(v)))).unwrap_or_else(|| "run time".into());
+            let mut default = e.default.as_ref().map(|v| format!("`{}`", cell(&eds_value(v)))).unwrap_or_else(|| "run time".into());
+            if let Some(values) = &e.values {
+                let list: Vec<String> = values.iter().map(|v| if *v >= 10 { format!("0x{v:X}") } else { v.to_string() }).collect();
+                default.push_str(&format!(" (one of {})", list.join(", ")));
+            }
+            let access = match &e.writable_in {
+                Some(states) => format!("{} (write in {})", eds_access(d, o, e, mode), states.iter().map(|s| s.name()).collect::<Vec<_>>().join(", ")),
+                None => eds_access(d, o, e, mode).to_string(),
+            };
             let _ = writeln!(
                 out,
-                "| {:04X} | {sub} | {} | {ty} | {} | {host} | {} | {default} | {} | {} |",
+                "| {:04X} | {sub} | {} | {ty} | {access} | {host} | {} | {default} | {} | {} |",
                 o.index,
                 cell(&e.name),
-                eds_access(d, o, e, mode),
                 if e.pdo_mapping { "yes" } else { "" },
                 e.storage.name(),
                 modes_text(&e.modes)

@@ -38,9 +38,13 @@ pub fn file_name(d: &Device, mode: Option<&str>) -> String {
     }
 }
 
-/// Objects and entries that exist in `mode`.
+/// Objects and entries a CAN master sees in `mode` (entries with access `none` are hidden).
 fn objects_in<'a>(d: &'a Device, mode: Option<&'a str>) -> impl Iterator<Item = (&'a Object, Vec<&'a Entry>)> + 'a {
-    d.objects.iter().filter(move |o| in_mode(&o.modes, mode)).map(move |o| (o, o.entries.iter().filter(|e| in_mode(&e.modes, mode)).collect()))
+    d.objects
+        .iter()
+        .filter(move |o| in_mode(&o.modes, mode))
+        .map(move |o| (o, o.entries.iter().filter(|e| in_mode(&e.modes, mode) && e.access != Access::None).collect::<Vec<_>>()))
+        .filter(|(_, entries)| !entries.is_empty())
 }
 
 /// Dummy entries 0x0001..0x0007 are declared through `[DummyUsage]`, not as sections.

@@ -3,7 +3,7 @@
 
 use crate::diag::Span;
 use crate::expr::Expr;
-use crate::types::{Access, DataType, HostAccess, ObjectKind, Storage, Sub0, WriteWhen};
+use crate::types::{Access, DataType, HostAccess, NmtState, ObjectKind, Storage, Sub0, WriteWhen};
 use std::collections::{BTreeMap, BTreeSet};
 
 #[derive(Debug, Clone)]
@@ -127,6 +127,8 @@ pub struct Mode {
     pub description: String,
     pub pins: BTreeMap<String, Level>,
     pub command: Option<String>,
+    /// Selected by an OD entry holding this value: (index, sub, value).
+    pub object: Option<(u16, u8, i64)>,
     pub span: Span,
 }
 
@@ -195,6 +197,10 @@ pub struct Entry {
     pub storage: Storage,
     pub description: String,
     pub modes: ModeSet,
+    /// The only values a write may store (besides `low`/`high`), if restricted.
+    pub values: Option<Vec<i64>>,
+    /// NMT states in which a CAN-side write is accepted; `None` means every state.
+    pub writable_in: Option<Vec<NmtState>>,
     pub spans: EntrySpans,
 }
 
@@ -213,6 +219,7 @@ pub struct EntrySpans {
     pub default: Span,
     pub low: Span,
     pub high: Span,
+    pub values: Span,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -256,6 +263,8 @@ pub struct PdoSet {
     pub max_mapped: u8,
     pub comm_access: Access,
     pub mapping_access: Access,
+    /// NMT states in which the mapping may be written.
+    pub mapping_writable_in: Option<Vec<NmtState>>,
     pub span: Span,
 }
 
@@ -525,7 +534,8 @@ impl Command {
             None => vec![self.code],
             Some(p) => {
                 let (lo, hi) = p.range.unwrap_or((0, p.mask >> p.mask.trailing_zeros()));
-                (lo..=hi).map(|v| (self.code & !p.mask) | ((v << p.mask.trailing_zeros()) & p.mask)).collect()
+                let values: Vec<u32> = p.values.clone().unwrap_or_else(|| (lo..=hi).collect());
+                values.into_iter().map(|v| (self.code & !p.mask) | ((v << p.mask.trailing_zeros()) & p.mask)).collect()
             }
         }
     }
@@ -543,6 +553,8 @@ pub struct CodeParam {
     pub name: String,
     pub mask: u32,
     pub range: Option<(u32, u32)>,
+    /// An explicit set of parameter values (GW1: PDO 0 and 4 in digital mode).
+    pub values: Option<Vec<u32>>,
 }
 
 #[derive(Debug, Clone)]

@@ -9,7 +9,7 @@ use crate::expr::{Expr, Vars};
 use crate::model::*;
 use crate::raw::{self, Num, S, Scalar};
 use crate::template::interpolate;
-use crate::types::{Access, DataType, HostAccess, ObjectKind, Storage, Sub0, WriteWhen, snake_case};
+use crate::types::{Access, DataType, HostAccess, NmtState, ObjectKind, Storage, Sub0, WriteWhen, snake_case};
 use std::collections::{BTreeMap, BTreeSet};
 
 pub const FORMAT_VERSION: u32 = 1;
@@ -132,6 +132,22 @@ impl Cx<'_> {
             self.err("spec-mode", span(list), "an entry's `modes` must be a subset of its object's `modes`");
         }
         Some(set)
+    }
+
+    /// `writable_in: [preoperational, ...]`.
+    fn nmt_states(&mut self, list: Option<&S<Vec<S<String>>>>) -> Option<Option<Vec<NmtState>>> {
+        let Some(list) = list else { return Some(None) };
+        let mut states = Vec::new();
+        for s in &list.value {
+            states.push(self.keyword(s, "NMT state", NmtState::parse, "preoperational, operational, stopped")?);
+        }
+        if states.is_empty() {
+            self.err("spec-structure", span(list), "`writable_in` must name at least one NMT state (omit it for every state)");
+            return None;
+        }
+        states.sort_unstable();
+        states.dedup();
+        Some(Some(states))
     }
 
     /// `repeat: { var, count }` or `{ var, from, to }` -> the variable and its values.
@@ -371,6 +387,7 @@ fn mode(cx: &mut Cx<'_>, m: &S<raw::Mode>) -> Mode {
     let v = &m.value;
     let mut pins = BTreeMap::new();
     let mut command = None;
+    let mut object = None;
     if let Some(sel) = &v.select {
         for (pin, lvl) in &sel.value.pins {
             if let Some(l) = level(cx, lvl) {
@@ -378,8 +395,17 @@ fn mode(cx: &mut Cx<'_>, m: &S<raw::Mode>) -> Mode {
             }
         }
         command = sel.value.command.as_ref().map(|c| c.value.clone());
+        if let Some(o) = &sel.value.object {
+            let none = Vars::new();
+            let index = cx.int_in(&o.value.index, &none, "index", 1, 0xFFFF);
+            let sub = o.value.sub.as_ref().map_or(Some(0), |n| cx.int_in(n, &none, "sub", 0, 254));
+            let value = cx.int(&o.value.value, &none, "value");
+            if let (Some(index), Some(sub), Some(value)) = (index, sub, value) {
+                object = Some((index, sub, value));
+            }
+        }
     }
-    Mode { name: v.name.value.clone(), description: v.description.clone().unwrap_or_default(), pins, command, span: span(m) }
+    Mode { name: v.name.value.clone(), description: v.description.clone().unwrap_or_default(), pins, command, object, span: span(m) }
 }
 
 fn expand_objects(cx: &mut Cx<'_>, items: &[S<raw::Object>], vars: &Vars, out: &mut Vec<Object>) {
@@ -566,6 +592,26 @@ fn entry(cx: &mut Cx<'_>, f: raw::EntryFields<'_>, sub: u8, at: Span, vars: &Var
         Some(Some(v))
     };
     let default = value(cx, f.default, "default", true)?;
+    let values = match f.values {
+        Some(list) => {
+            let mut v = Vec::new();
+            for n in &list.value {
+                v.push(cx.int(n, vars, "allowed value")?);
+            }
+            if v.is_empty() || data_type.int_range().is_none() {
+                cx.err("spec-structure", span(list), "`values` lists the allowed values of an integer entry and must not be empty");
+                return None;
+            }
+            Some(v)
+        }
+        None => None,
+    };
+    let writable_in = cx.nmt_states(f.writable_in)?;
+    if let (Some(_), Some(list)) = (&writable_in, f.writable_in)
+        && !access.writable()
+    {
+        cx.err("spec-structure", span(list), format!("`writable_in` restricts writes, but access `{access}` allows none"));
+    }
     let low = value(cx, f.low, "low limit", false)?;
     let high = value(cx, f.high, "high limit", false)?;
     let span_of = |s: Option<Span>| s.unwrap_or(at);
@@ -590,6 +636,8 @@ fn entry(cx: &mut Cx<'_>, f: raw::EntryFields<'_>, sub: u8, at: Span, vars: &Var
         storage,
         description: f.description.and_then(|d| cx.text(d, vars)).unwrap_or_default(),
         modes: cx.modes(f.modes, modes),
+        values,
+        writable_in,
         spans: EntrySpans {
             at,
             data_type: span(type_s),
@@ -597,6 +645,7 @@ fn entry(cx: &mut Cx<'_>, f: raw::EntryFields<'_>, sub: u8, at: Span, vars: &Var
             default: span_of(f.default.map(span)),
             low: span_of(f.low.map(span)),
             high: span_of(f.high.map(span)),
+            values: span_of(f.values.map(span)),
         },
     })
 }
@@ -638,6 +687,7 @@ fn pdo_set(cx: &mut Cx<'_>, dir: PdoDir, set: &S<raw::PdoSet>) -> Option<(PdoSet
         max_mapped: cx.int_in(&v.max_mapped, &none, "max_mapped", 0, 64)?,
         comm_access: access(cx, &v.comm_access)?,
         mapping_access: access(cx, &v.mapping_access)?,
+        mapping_writable_in: cx.nmt_states(v.writable_in.as_ref())?,
         span: span(set),
     };
     let mut pdos = Vec::new();
@@ -709,7 +759,9 @@ impl PdoEntries<'_> {
             storage: self.storage,
             description: String::new(),
             modes: self.pdo.modes.clone(),
-            spans: EntrySpans { at, data_type: at, access: at, default: at, low: at, high: at },
+            values: None,
+            writable_in: None,
+            spans: EntrySpans { at, data_type: at, access: at, default: at, low: at, high: at, values: at },
         }
     }
 }
@@ -764,9 +816,11 @@ fn pdo_objects(config: &PdoConfig, persistent: bool) -> Vec<Object> {
         });
         let count = i64::try_from(pdo.map.len()).unwrap_or(i64::MAX);
         let mut mapping = vec![make.entry(0, "Number of mapped objects".into(), DataType::Unsigned8, set.mapping_access, count)];
+        mapping[0].writable_in.clone_from(&set.mapping_writable_in);
         for sub in 1..=set.max_mapped {
             let value = pdo.map.get(usize::from(sub - 1)).map_or(0, |m| i64::from(m.encoded()));
             let mut e = make.entry(sub, format!("Mapped object {sub}"), DataType::Unsigned32, set.mapping_access, value);
+            e.writable_in.clone_from(&set.mapping_writable_in);
             if let Some(m) = pdo.map.get(usize::from(sub - 1)) {
                 e.spans.default = m.span;
             }
@@ -1150,6 +1204,19 @@ fn command(cx: &mut Cx<'_>, c: &S<raw::Command>, framing: &Framing) -> Option<Co
             mask: cx.int_in(&p.value.mask, &none, "code_param mask", 1, code_max)?,
             range: match &p.value.range {
                 Some(r) => Some((cx.int_in(&r.value.0, &none, "range start", 0, code_max)?, cx.int_in(&r.value.1, &none, "range end", 0, code_max)?)),
+                None => None,
+            },
+            values: match &p.value.values {
+                Some(list) => {
+                    if p.value.range.is_some() {
+                        cx.err("spec-structure", span(list), "`code_param` takes either `range` or `values`");
+                    }
+                    let mut v = Vec::new();
+                    for n in &list.value {
+                        v.push(cx.int_in(n, &none, "code parameter value", 0, code_max)?);
+                    }
+                    Some(v)
+                }
                 None => None,
             },
         }),

@@ -189,6 +189,18 @@ pub struct ModeSelect {
     pub pins: BTreeMap<String, S<String>>,
     #[serde(default)]
     pub command: Option<S<String>>,
+    #[serde(default)]
+    pub object: Option<S<ModeObject>>,
+}
+
+/// A mode chosen by the value of an OD entry (CR3101's PDO operating mode 20F5).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModeObject {
+    pub index: Num,
+    #[serde(default)]
+    pub sub: Option<Num>,
+    pub value: Num,
 }
 
 #[derive(Debug, Deserialize)]
@@ -242,6 +254,10 @@ macro_rules! with_entry_fields {
             pub description: Option<S<String>>,
             #[serde(default)]
             pub modes: Option<S<Vec<S<String>>>>,
+            #[serde(default)]
+            pub values: Option<S<Vec<Num>>>,
+            #[serde(default)]
+            pub writable_in: Option<S<Vec<S<String>>>>,
         }
 
         impl $name {
@@ -261,6 +277,8 @@ macro_rules! with_entry_fields {
                     storage: self.storage.as_ref(),
                     description: self.description.as_ref(),
                     modes: self.modes.as_ref(),
+                    values: self.values.as_ref(),
+                    writable_in: self.writable_in.as_ref(),
                 }
             }
         }
@@ -284,6 +302,8 @@ pub struct EntryFields<'a> {
     pub storage: Option<&'a S<String>>,
     pub description: Option<&'a S<String>>,
     pub modes: Option<&'a S<Vec<S<String>>>>,
+    pub values: Option<&'a S<Vec<Num>>>,
+    pub writable_in: Option<&'a S<Vec<S<String>>>>,
 }
 
 with_entry_fields! {
@@ -332,6 +352,8 @@ pub struct PdoSet {
     pub comm_access: Option<S<String>>,
     #[serde(default)]
     pub mapping_access: Option<S<String>>,
+    #[serde(default)]
+    pub writable_in: Option<S<Vec<S<String>>>>,
     #[serde(default)]
     pub pdos: Vec<S<PdoDefault>>,
 }
@@ -533,6 +555,8 @@ pub struct CodeParam {
     pub mask: Num,
     #[serde(default)]
     pub range: Option<S<(Num, Num)>>,
+    #[serde(default)]
+    pub values: Option<S<Vec<Num>>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -195,6 +195,9 @@ pub enum Access {
     /// Read/write, mapped into RPDOs (process output).
     Rww,
     Const,
+    /// Not reachable from the CAN bus (an SDO gets "object does not exist"); the entry exists
+    /// for the device and, where `host_access` allows, for the serial host. Not in the EDS.
+    None,
 }
 
 impl Access {
@@ -206,11 +209,13 @@ impl Access {
             "rwr" => Access::Rwr,
             "rww" => Access::Rww,
             "const" => Access::Const,
+            "none" => Access::None,
             _ => return None,
         })
     }
     pub fn name(self) -> &'static str {
         match self {
+            Access::None => "none",
             Access::Ro => "ro",
             Access::Wo => "wo",
             Access::Rw => "rw",
@@ -220,7 +225,7 @@ impl Access {
         }
     }
     pub fn readable(self) -> bool {
-        !matches!(self, Access::Wo)
+        !matches!(self, Access::Wo | Access::None)
     }
     pub fn writable(self) -> bool {
         matches!(self, Access::Wo | Access::Rw | Access::Rwr | Access::Rww)
@@ -230,6 +235,32 @@ impl Access {
 impl fmt::Display for Access {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+/// NMT states (CiA 301) in which a CAN-side write may be restricted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum NmtState {
+    PreOperational,
+    Operational,
+    Stopped,
+}
+
+impl NmtState {
+    pub fn parse(s: &str) -> Option<NmtState> {
+        Some(match s {
+            "preoperational" => NmtState::PreOperational,
+            "operational" => NmtState::Operational,
+            "stopped" => NmtState::Stopped,
+            _ => return None,
+        })
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            NmtState::PreOperational => "preoperational",
+            NmtState::Operational => "operational",
+            NmtState::Stopped => "stopped",
+        }
     }
 }
 

@@ -71,6 +71,23 @@ pub fn mode_select(d: &Device, diags: &mut Diagnostics) {
                 diags.push(Diagnostic::error("mode-select", m.span, format!("mode `{}` is selected by pin `{pin}`, which is not a configuration pin", m.name)));
             }
         }
+        if let Some((index, sub, value)) = m.object {
+            match d.objects.iter().find(|o| o.index == index).and_then(|o| o.entry(sub)) {
+                None => diags.push(Diagnostic::error(
+                    "mode-select",
+                    m.span,
+                    format!("mode `{}` is selected by {}.{sub}, which does not exist", m.name, hex4(index)),
+                )),
+                Some(e) if e.data_type.int_range().is_some_and(|(lo, hi)| !(lo..=hi).contains(&i128::from(value))) => {
+                    diags.push(Diagnostic::error(
+                        "mode-select",
+                        m.span,
+                        format!("mode `{}` needs {}.{sub} = {value}, which a {} cannot hold", m.name, hex4(index), e.data_type),
+                    ));
+                }
+                Some(_) => {}
+            }
+        }
         if let Some(cmd) = &m.command
             && !d.serial.as_ref().is_some_and(|s| s.commands.iter().any(|c| &c.name == cmd))
         {

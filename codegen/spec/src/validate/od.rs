@@ -181,6 +181,25 @@ fn int_bounds(e: &crate::model::Entry) -> Option<(i128, i128)> {
 pub fn default_range(d: &Device, diags: &mut Diagnostics) {
     for o in &d.objects {
         for e in &o.entries {
+            if let (Some(values), Some((lo, hi))) = (&e.values, e.data_type.int_range()) {
+                if let Some(v) = values.iter().find(|v| !(lo..=hi).contains(&i128::from(**v))) {
+                    diags.push(Diagnostic::error(
+                        "od-default-range",
+                        e.spans.values,
+                        format!("allowed value {v:#X} of {}.{} does not fit {}", hex4(o.index), e.sub, e.data_type),
+                    ));
+                }
+                if let Some(v) = e.default.as_ref().and_then(|v| v.int_for(1)).filter(|v| !values.contains(v)) {
+                    diags.push(
+                        Diagnostic::error(
+                            "od-default-range",
+                            e.spans.default,
+                            format!("default {v:#X} of {}.{} is not one of its allowed `values`", hex4(o.index), e.sub),
+                        )
+                        .note_at(e.spans.values, "allowed values"),
+                    );
+                }
+            }
             let Some(default) = &e.default else { continue };
             match default {
                 Value::Int(expr) => {
