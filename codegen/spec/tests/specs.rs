@@ -87,8 +87,10 @@ fn co401gw1_modes_and_side_dependent_access() {
         d.serial.as_ref().map(|s| &s.framing),
         Some(Framing::LengthByte { inter_byte_timeout_ms: 10, resync_pause_ms: 50, extension_threshold: 0x80 })
     ));
+    assert_eq!(node_id.access, Access::None, "100B is not reachable from CAN");
     for mode in ["mixed", "digital"] {
-        assert!(eds::export(&d, Some(mode)).is_ok());
+        let text = eds::export(&d, Some(mode)).expect("exports");
+        assert!(!text.contains("[100B]") && !text.contains("[100E]"), "CAN-inaccessible objects stay out of the EDS");
     }
     assert!(eds::export(&d, None).is_err(), "a device with modes needs --mode");
 }
@@ -108,6 +110,12 @@ fn cr3101_files_records_and_redundant_pairs() {
     pairs.sort_unstable();
     assert_eq!(pairs, [(0x2002, 0x2003), (0x20F0, 0x20F1), (0x20F2, 0x20F3)]);
     assert!(d.pdo.pdos.iter().filter(|p| p.dir == PdoDir::Rx).count() >= 8);
+    let selectors: Vec<_> = d.modes.iter().map(|m| m.object).collect();
+    assert_eq!(selectors, [Some((0x20F5, 0, 0)), Some((0x20F5, 0, 1))], "PDO operating mode 20F5 selects the mode");
+    for f in 0..8_u16 {
+        let op_mode = d.object(0x3003 + 0x100 * f, None).and_then(|o| o.entry(1)).expect("3x03.1");
+        assert_eq!(op_mode.values.as_deref(), Some(&[0x01, 0x02, 0x03, 0x10][..]));
+    }
 }
 
 #[test]
