@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 
 use clap::{Parser, Subcommand};
+use coforge_spec::model::Direction;
 use coforge_spec::{Loaded, load_file};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -42,6 +43,16 @@ enum Cmd {
         node_id: u8,
         #[arg(long)]
         mode: Option<String>,
+    },
+    /// Decode one serial frame (hex bytes) by a spec's framing and command table.
+    Decode {
+        spec: PathBuf,
+        /// The frame, e.g. "33 12 50 04" (quote it, or pass the bytes as separate arguments).
+        #[arg(required = true, num_args = 1..)]
+        bytes: Vec<String>,
+        /// Which side sent it; without it both directions are tried.
+        #[arg(long, value_parser = ["host", "device"])]
+        from: Option<String>,
     },
     /// Print a JSON summary of a spec: name, identifier, modes, EDS file names, counts.
     Info { spec: PathBuf },
@@ -135,6 +146,22 @@ fn run(cmd: Cmd) -> Result<ExitCode, String> {
             let json = coforge_spec::eds::model_json(device, mode.as_deref(), node_id).map_err(|e| e.to_string())?;
             write_output(None, &format!("{json}\n"))?;
             Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Decode { spec, bytes, from } => {
+            let Some(loaded) = load_reporting(&spec) else { return Ok(ExitCode::FAILURE) };
+            let device = loaded.device().ok_or("spec did not load")?;
+            let text = bytes.join(" ");
+            let direction = from.as_deref().map(|f| if f == "host" { Direction::HostToDevice } else { Direction::DeviceToHost });
+            match coforge_spec::frame::describe(device, &text, direction) {
+                Ok(lines) => {
+                    write_output(None, &lines)?;
+                    Ok(ExitCode::SUCCESS)
+                }
+                Err(e) => {
+                    eprintln!("error: {text}: {e}");
+                    Ok(ExitCode::FAILURE)
+                }
+            }
         }
         Cmd::Info { spec } => {
             let Some(loaded) = load_reporting(&spec) else { return Ok(ExitCode::FAILURE) };

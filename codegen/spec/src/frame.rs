@@ -1,7 +1,7 @@
 //! Decoding whole frames by a spec's own framing and command table. Used to check the
 //! datasheet examples, and by `coforge decode`.
 
-use crate::model::{Command, Direction, ExampleValue, FieldType, Framing, LengthCounts, Serial};
+use crate::model::{Command, Device, Direction, ExampleValue, FieldType, Framing, LengthCounts, Serial};
 use std::collections::BTreeMap;
 
 /// A frame split by the framing rule: the command code byte(s) and the data after them.
@@ -132,4 +132,38 @@ pub fn decode_fields(cmd: &Command, split: &Split) -> Result<BTreeMap<String, Ex
 /// Finds the commands a frame could be, in one direction.
 pub fn candidates<'a>(serial: &'a Serial, direction: Direction, split: &Split) -> Vec<&'a Command> {
     serial.commands.iter().filter(|c| c.direction == direction && c.codes().contains(&split.code) && c.length_code == split.length_code).collect()
+}
+
+/// Decodes a hex frame into readable lines, one per command it can be (`coforge decode`).
+pub fn describe(device: &Device, hex: &str, direction: Option<Direction>) -> Result<String, String> {
+    let serial = device.serial.as_ref().ok_or_else(|| format!("{} has no serial protocol", device.identity.name))?;
+    let bytes: Vec<u8> = crate::normalize::hex_bytes(hex, false)?.into_iter().flatten().collect();
+    let split = split(&serial.framing, &bytes)?;
+    let dirs = match direction {
+        Some(d) => vec![d],
+        None => vec![Direction::HostToDevice, Direction::DeviceToHost],
+    };
+    let mut out = String::new();
+    let mut problems = Vec::new();
+    for dir in dirs {
+        for cmd in candidates(serial, dir, &split) {
+            match decode_fields(cmd, &split) {
+                Ok(values) => {
+                    let fields: Vec<String> = values
+                        .iter()
+                        .map(|(k, v)| match v {
+                            ExampleValue::Int(i) => format!("{k}={i:#X}"),
+                            ExampleValue::Bytes(b) => format!("{k}=[{}]", b.iter().map(|x| format!("{x:02X}")).collect::<Vec<_>>().join(" ")),
+                        })
+                        .collect();
+                    out.push_str(&format!("{} ({}, {:?}): {}\n", cmd.name, dir.name(), cmd.kind, fields.join(" ")));
+                }
+                Err(e) => problems.push(format!("`{}`: {e}", cmd.name)),
+            }
+        }
+    }
+    if out.is_empty() {
+        return Err(if problems.is_empty() { format!("no command uses code {:#04X}", split.code) } else { problems.join("; ") });
+    }
+    Ok(out)
 }
