@@ -98,10 +98,10 @@ fn decode_names_the_command_and_its_fields() {
     // Without --from the frame fits a request and an (empty) answer.
     assert_eq!(
         String::from_utf8_lossy(&o.stdout),
-        "read_request (host_to_device, Request): index=0x1018 sub=0x1\nread_answer (device_to_host, Response): data=[] index=0x1018 sub=0x1\n"
+        "read_request (host_to_device, request): index=0x1018 sub=0x1\nread_answer (device_to_host, response): data=[] index=0x1018 sub=0x1\n"
     );
     let o = coforge(&["decode", "codegen/spec/tests/fixtures/valid/minimal.yaml", "--from", "device", "31", "01", "00"]);
-    assert_eq!(String::from_utf8_lossy(&o.stdout), "write_tpdo_ack (device_to_host, Ack): pdo=0x1 status=0x0\n");
+    assert_eq!(String::from_utf8_lossy(&o.stdout), "write_tpdo_ack (device_to_host, ack): pdo=0x1 status=0x0\n");
     let o = coforge(&["decode", "codegen/spec/tests/fixtures/valid/minimal.yaml", "21 05 18"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("DataLen says 5 data bytes but 1 follow"), "{}", stderr(&o));

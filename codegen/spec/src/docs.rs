@@ -39,7 +39,7 @@ pub fn markdown(d: &Device) -> String {
     if !d.modes.is_empty() {
         let _ = writeln!(out, "## Operating modes\n\n| Mode | Selected by | Description |\n|---|---|---|");
         for m in &d.modes {
-            let mut sel: Vec<String> = m.pins.iter().map(|(p, l)| format!("{p} {}", format!("{l:?}").to_lowercase())).collect();
+            let mut sel: Vec<String> = m.pins.iter().map(|(p, l)| format!("{p} {}", l.name())).collect();
             sel.extend(m.object.iter().map(|(i, s, v)| format!("{i:04X}.{s} = {v}")));
             sel.extend(m.command.iter().map(|c| format!("command `{c}`")));
             let _ = writeln!(out, "| `{}` | {} | {} |", m.name, sel.join(" + "), cell(&m.description));
@@ -115,7 +115,7 @@ pub fn markdown(d: &Device) -> String {
         let _ = writeln!(out, "## Emergencies\n\n| Name | Frame | Trigger | NMT | Outputs | Reset |\n|---|---|---|---|---|---|");
         for e in &d.emergencies {
             let frame = e.frame().iter().map(|b| b.map_or("xx".into(), |v| format!("{v:02X}"))).collect::<Vec<_>>().join(" ");
-            let _ = writeln!(out, "| `{}` | `{frame}` | {} | {:?} | {:?} | {} |", e.name, cell(&e.trigger), e.nmt, e.outputs, cell(&e.reset));
+            let _ = writeln!(out, "| `{}` | `{frame}` | {} | {} | {} | {} |", e.name, cell(&e.trigger), e.nmt.name(), e.outputs.name(), cell(&e.reset));
         }
         let _ = writeln!(out);
     }
@@ -166,9 +166,9 @@ pub fn markdown(d: &Device) -> String {
             };
             let _ = writeln!(
                 out,
-                "| {code} | {dir} | `{}` | {:?} | {len} | {fields} | {} |",
+                "| {code} | {dir} | `{}` | {} | {len} | {fields} | {} |",
                 c.name,
-                c.kind,
+                c.kind.name(),
                 c.reply.as_deref().map(|r| format!("`{r}`")).unwrap_or_default()
             );
         }
@@ -214,7 +214,7 @@ fn hardware(out: &mut String, d: &Device) {
     if let Some(cfg) = &hw.config_pins {
         let _ = writeln!(out, "### Configuration pins\n\n| Pin | Level | Meaning |\n|---|---|---|");
         for s in &cfg.settings {
-            let _ = writeln!(out, "| {} | {:?} | {} |", s.pin, s.level, cell(&s.meaning));
+            let _ = writeln!(out, "| {} | {} | {} |", s.pin, s.level.name(), cell(&s.meaning));
         }
         let _ = writeln!(out);
     }

@@ -156,7 +156,7 @@ pub fn describe(device: &Device, hex: &str, direction: Option<Direction>) -> Res
                             ExampleValue::Bytes(b) => format!("{k}=[{}]", b.iter().map(|x| format!("{x:02X}")).collect::<Vec<_>>().join(" ")),
                         })
                         .collect();
-                    out.push_str(&format!("{} ({}, {:?}): {}\n", cmd.name, dir.name(), cmd.kind, fields.join(" ")));
+                    out.push_str(&format!("{} ({}, {}): {}\n", cmd.name, dir.name(), cmd.kind.name(), fields.join(" ")));
                 }
                 Err(e) => problems.push(format!("`{}`: {e}", cmd.name)),
             }

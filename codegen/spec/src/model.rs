@@ -113,6 +113,17 @@ pub enum Level {
     Any,
 }
 
+impl Level {
+    /// The spec keyword.
+    pub fn name(self) -> &'static str {
+        match self {
+            Level::High => "high",
+            Level::Low => "low",
+            Level::Any => "any",
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct PinSetting {
     pub pin: String,
@@ -314,6 +325,28 @@ pub enum OutputEffect {
     ErrorState,
 }
 
+impl NmtEffect {
+    /// The spec keyword.
+    pub fn name(self) -> &'static str {
+        match self {
+            NmtEffect::None => "none",
+            NmtEffect::ErrorBehavior => "error_behavior",
+            NmtEffect::PreOperational => "preoperational",
+            NmtEffect::Stopped => "stopped",
+        }
+    }
+}
+
+impl OutputEffect {
+    /// The spec keyword.
+    pub fn name(self) -> &'static str {
+        match self {
+            OutputEffect::Unchanged => "unchanged",
+            OutputEffect::ErrorState => "error_state",
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct Emergency {
     pub name: String,
@@ -503,6 +536,19 @@ pub enum CommandKind {
     Command,
     Ack,
     Indication,
+}
+
+impl CommandKind {
+    /// The spec keyword.
+    pub fn name(self) -> &'static str {
+        match self {
+            CommandKind::Request => "request",
+            CommandKind::Response => "response",
+            CommandKind::Command => "command",
+            CommandKind::Ack => "ack",
+            CommandKind::Indication => "indication",
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
