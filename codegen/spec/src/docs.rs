@@ -129,8 +129,12 @@ pub fn markdown(d: &Device) -> String {
                     "command byte, DataLen byte, data; a gap over {inter_byte_timeout_ms} ms invalidates a frame, a {resync_pause_ms} ms pause resynchronises, DataLen >= 0x{extension_threshold:02X} is an extension code"
                 )
             }
-            Framing::StartLengthCrc { start_byte, length_bytes, max_payload, crc, .. } => format!(
-                "start byte 0x{start_byte:02X}, {length_bytes}-byte length, payload (at most {max_payload} bytes), CRC-{} (poly 0x{:X}, init 0x{:X}, check 0x{:X}) sent {} first",
+            Framing::StartLengthCrc { start_byte, start_bits, length_bytes, max_payload, crc, .. } => format!(
+                "start byte 0x{start_byte:02X}{}, {length_bytes}-byte length, payload (at most {max_payload} bytes), CRC-{} (poly 0x{:X}, init 0x{:X}, check 0x{:X}) sent {} first",
+                start_bits.map_or(String::new(), |b| format!(
+                    " (bits: network 0x{:02X}, CRC present 0x{:02X}, 16-bit length 0x{:02X})",
+                    b.network, b.crc, b.long_length
+                )),
                 crc.width,
                 crc.poly,
                 crc.init,

@@ -34,15 +34,18 @@ pub fn split(framing: &Framing, bytes: &[u8]) -> Result<Split, String> {
             }
             Ok(Split { code: u32::from(*code), length_code: None, data: data.to_vec() })
         }
-        Framing::StartLengthCrc { start_byte, length_bytes, length_counts, max_payload, crc } => {
+        Framing::StartLengthCrc { start_byte, start_bits, length_bytes, length_counts, max_payload, crc } => {
             let (&start, rest) = bytes.split_first().ok_or("the frame is empty")?;
-            if start != *start_byte {
-                return Err(format!("the frame starts with {start:#04X}, not the start byte {start_byte:#04X}"));
-            }
-            let lb = usize::from(*length_bytes);
+            // With option bits the start byte chooses CRC and length width; otherwise it is fixed.
+            let (has_crc, width) = match start_bits {
+                Some(bits) => bits.options(start, *length_bytes)?,
+                None if start == *start_byte => (true, *length_bytes),
+                None => return Err(format!("the frame starts with {start:#04X}, not the start byte {start_byte:#04X}")),
+            };
+            let lb = usize::from(width);
             let len_raw = rest.get(..lb).ok_or("the frame ends inside the length field")?;
             let declared = len_raw.iter().rev().fold(0_usize, |acc, &b| acc << 8 | usize::from(b));
-            let crc_len = usize::from(crc.width).div_ceil(8);
+            let crc_len = if has_crc { usize::from(crc.width).div_ceil(8) } else { 0 };
             let payload_len = match length_counts {
                 LengthCounts::Payload => Some(declared),
                 LengthCounts::PayloadAndCrc => declared.checked_sub(crc_len),
@@ -70,6 +73,10 @@ pub fn split(framing: &Framing, bytes: &[u8]) -> Result<Split, String> {
             }
             if crc.covers_payload {
                 covered.extend_from_slice(payload);
+            }
+            if !has_crc {
+                let (&code, data) = payload.split_first().ok_or("the payload is empty: no command code")?;
+                return Ok(Split { code: u32::from(code), length_code: None, data: data.to_vec() });
             }
             let got = if crc.little_endian {
                 crc_bytes.iter().rev().fold(0_u64, |a, &b| a << 8 | u64::from(b))

@@ -400,7 +400,7 @@ pub enum Framing {
     /// CO401GW1: command byte, DataLen byte, data.
     LengthByte { inter_byte_timeout_ms: u32, resync_pause_ms: u32, extension_threshold: u8 },
     /// CANopenIA: start byte, length, payload, CRC.
-    StartLengthCrc { start_byte: u8, length_bytes: u8, length_counts: LengthCounts, max_payload: u16, crc: CrcParams },
+    StartLengthCrc { start_byte: u8, start_bits: Option<StartBits>, length_bytes: u8, length_counts: LengthCounts, max_payload: u16, crc: CrcParams },
 }
 
 impl Framing {
@@ -419,6 +419,28 @@ impl Framing {
             // The command code is the first payload byte.
             Framing::StartLengthCrc { max_payload, .. } => u32::from(*max_payload).saturating_sub(1),
         }
+    }
+}
+
+/// Masks of the start byte's option bits: the network number (never 0), CRC present, and a
+/// 16-bit length field. Bits outside the three masks are reserved and must be 0.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StartBits {
+    pub network: u8,
+    pub crc: u8,
+    pub long_length: u8,
+}
+
+impl StartBits {
+    /// What a start byte selects: (CRC present, length field width), or why it is invalid.
+    pub fn options(self, start: u8, length_bytes: u8) -> Result<(bool, u8), String> {
+        if start & !(self.network | self.crc | self.long_length) != 0 {
+            return Err(format!("start byte {start:#04X} sets reserved bits"));
+        }
+        if start & self.network == 0 {
+            return Err(format!("start byte {start:#04X} names network 0, which is reserved"));
+        }
+        Ok((start & self.crc != 0, if start & self.long_length != 0 { 2 } else { length_bytes }))
     }
 }
 

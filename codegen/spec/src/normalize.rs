@@ -1001,11 +1001,12 @@ fn framing(cx: &mut Cx<'_>, f: &S<raw::Framing>) -> Option<Framing> {
     let v = &f.value;
     let at = span(f);
     // Which keys each kind takes, so that a key meant for another kind is reported.
-    let given: [(&str, Option<Span>); 8] = [
+    let given: [(&str, Option<Span>); 9] = [
         ("resync_pause_ms", v.resync_pause_ms.as_ref().map(span)),
         ("inter_byte_timeout_ms", v.inter_byte_timeout_ms.as_ref().map(span)),
         ("extension_threshold", v.extension_threshold.as_ref().map(span)),
         ("start_byte", v.start_byte.as_ref().map(span)),
+        ("start_byte_bits", v.start_byte_bits.as_ref().map(span)),
         ("length_bytes", v.length_bytes.as_ref().map(span)),
         ("length_counts", v.length_counts.as_ref().map(span)),
         ("max_payload", v.max_payload.as_ref().map(span)),
@@ -1014,7 +1015,9 @@ fn framing(cx: &mut Cx<'_>, f: &S<raw::Framing>) -> Option<Framing> {
     let allowed: &[&str] = match v.kind.value.as_str() {
         "nibble_length" => &["resync_pause_ms"],
         "length_byte" => &["resync_pause_ms", "inter_byte_timeout_ms", "extension_threshold"],
-        "start_length_crc" => &["start_byte", "length_bytes", "length_counts", "max_payload", "crc", "resync_pause_ms", "inter_byte_timeout_ms"],
+        "start_length_crc" => {
+            &["start_byte", "start_byte_bits", "length_bytes", "length_counts", "max_payload", "crc", "resync_pause_ms", "inter_byte_timeout_ms"]
+        }
         other => {
             cx.err("spec-value", span(&v.kind), format!("unknown framing kind `{other}`; expected one of: nibble_length, length_byte, start_length_crc"));
             return None;
@@ -1065,7 +1068,27 @@ fn framing(cx: &mut Cx<'_>, f: &S<raw::Framing>) -> Option<Framing> {
                 cx.err("spec-structure", at, "`start_length_crc` framing needs `crc`");
                 return None;
             };
-            Framing::StartLengthCrc { start_byte, length_bytes, length_counts, max_payload, crc: crc_params(cx, crc)? }
+            let start_bits = match &v.start_byte_bits {
+                Some(b) => {
+                    let mut mask = |n: &Num, what: &str| cx.int_in::<u8>(n, &none, what, 1, 0xFF);
+                    let bits = StartBits {
+                        network: mask(&b.value.network, "network mask")?,
+                        crc: mask(&b.value.crc, "crc flag")?,
+                        long_length: mask(&b.value.long_length, "long_length flag")?,
+                    };
+                    if bits.network & bits.crc != 0 || bits.network & bits.long_length != 0 || bits.crc & bits.long_length != 0 {
+                        cx.err("spec-structure", span(b), "the start byte's `network`, `crc` and `long_length` bits must not overlap");
+                        return None;
+                    }
+                    if let Err(e) = bits.options(start_byte, length_bytes) {
+                        cx.err("spec-value", span(b), format!("the default {e}"));
+                        return None;
+                    }
+                    Some(bits)
+                }
+                None => None,
+            };
+            Framing::StartLengthCrc { start_byte, start_bits, length_bytes, length_counts, max_payload, crc: crc_params(cx, crc)? }
         }
     })
 }

@@ -449,6 +449,8 @@ pub struct Framing {
     #[serde(default)]
     pub start_byte: Option<Num>,
     #[serde(default)]
+    pub start_byte_bits: Option<S<StartByteBits>>,
+    #[serde(default)]
     pub length_bytes: Option<Num>,
     #[serde(default)]
     pub length_counts: Option<S<String>>,
@@ -458,6 +460,15 @@ pub struct Framing {
     pub crc: Option<S<Crc>>,
     #[serde(default)]
     pub description: Option<String>,
+}
+
+/// Bit fields of a start byte that also carries frame options (CANopenIA 6.1).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StartByteBits {
+    pub network: Num,
+    pub crc: Num,
+    pub long_length: Num,
 }
 
 #[derive(Debug, Deserialize)]
