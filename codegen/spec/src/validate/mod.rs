@@ -33,6 +33,7 @@ pub const RULES: &[Rule] = &[
     Rule { id: "od-array-uniform", summary: "the sub-entries 1..n of an ARRAY do not share one data type", check: od::array_uniform },
     Rule { id: "od-default-range", summary: "a default does not fit its data type, its length or its limits", check: od::default_range },
     Rule { id: "od-limits", summary: "a low limit exceeds the high limit, or a limit does not fit the type", check: od::limits },
+    Rule { id: "od-storage", summary: "persistent entries exist but the store/restore objects 1010/1011 do not", check: od::storage },
     Rule { id: "od-identity", summary: "1000/1018 defaults disagree with the device identity", check: od::identity },
     Rule { id: "pdo-duplicate", summary: "a PDO number is defined twice in one mode", check: pdo::duplicate },
     Rule { id: "pdo-mapping-target", summary: "a default mapping points at a missing object or sub-index", check: pdo::mapping_target },

@@ -3,7 +3,7 @@
 use super::hex4;
 use crate::diag::{Diagnostic, Diagnostics};
 use crate::model::{Device, Object, Value, modes_overlap};
-use crate::types::{Access, DataType, ObjectKind, Sub0};
+use crate::types::{Access, DataType, ObjectKind, Storage, Sub0};
 use std::collections::BTreeMap;
 
 pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
@@ -279,6 +279,29 @@ pub fn limits(d: &Device, diags: &mut Diagnostics) {
                 diags.push(
                     Diagnostic::error("od-limits", e.spans.low, format!("low limit {lo:#X} of {}.{} exceeds its high limit {hi:#X}", hex4(o.index), e.sub))
                         .note_at(e.spans.high, "high limit"),
+                );
+            }
+        }
+    }
+}
+
+pub fn storage(d: &Device, diags: &mut Diagnostics) {
+    for mode in d.mode_names() {
+        let persistent = d
+            .objects
+            .iter()
+            .filter(|o| !o.generated && crate::model::in_mode(&o.modes, mode))
+            .find_map(|o| o.entries.iter().find(|e| e.storage == Storage::Persistent).map(|e| (o, e)));
+        let Some((o, e)) = persistent else { continue };
+        for (index, what) in [(0x1010, "store parameters"), (0x1011, "restore default parameters")] {
+            if d.object(index, mode).is_none() {
+                diags.push(
+                    Diagnostic::error(
+                        "od-storage",
+                        e.spans.at,
+                        format!("{}.{} is `persistent`, but {} ({what}) does not exist", hex4(o.index), e.sub, hex4(index)),
+                    )
+                    .note("persistent entries are saved by 1010 and restored by 1011; add them or use `storage: ram`"),
                 );
             }
         }
