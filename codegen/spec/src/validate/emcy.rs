@@ -24,6 +24,22 @@ pub fn example(d: &Device, diags: &mut Diagnostics) {
     }
 }
 
+/// CiA 301 (1001h): the generic error bit is set whenever any other error bit is.
+pub fn register(d: &Device, diags: &mut Diagnostics) {
+    for e in &d.emergencies {
+        if e.error_register != 0 && e.error_register & 0x01 == 0 {
+            diags.push(
+                Diagnostic::error(
+                    "emcy-register",
+                    e.span,
+                    format!("emergency `{}` sends error register {:#04X} without the generic error bit 0", e.name, e.error_register),
+                )
+                .note("CiA 301 sets bit 0 of 1001h whenever any error is active"),
+            );
+        }
+    }
+}
+
 pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
     for (i, a) in d.emergencies.iter().enumerate() {
         if !a.name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_') || a.name.is_empty() {
