@@ -32,6 +32,9 @@ fn main() -> ExitCode {
 
 pub type Result<T = ()> = std::result::Result<T, String>;
 
+/// Firmware crates that must build for `thumbv6m-none-eabi` (Cortex-M0, no atomics).
+const NO_STD_CRATES: &[&str] = &["coforge-link"];
+
 pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").canonicalize().unwrap_or_else(|_| PathBuf::from(".."))
 }
@@ -115,8 +118,11 @@ fn test() -> Result {
     run(cargo().args(["fmt", "--all", "--check"]))?;
     run(cargo().args(["clippy", "--quiet", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
 
-    println!("xtask: [2/5] Rust tests");
+    println!("xtask: [2/5] Rust tests, and the no_std crates for the smallest target");
     run(cargo().args(["test", "--workspace"]))?;
+    for krate in NO_STD_CRATES {
+        run(cargo().args(["build", "--quiet", "--release", "-p", krate, "--target", "thumbv6m-none-eabi"]))?;
+    }
 
     println!("xtask: [3/5] specs: check and canonical formatting");
     run(cargo().args(["build", "--quiet", "-p", "coforge"]))?;

@@ -1,0 +1,91 @@
+//! Serial framing and integrity for coforge devices, `no_std` and allocation-free.
+//!
+//! Three framings, one per datasheet protocol, each with an encoder and a streaming decoder:
+//! - [`nibble`]: CO401Memory1, `CMD << 4 | LEN` then LEN data bytes; a pause resynchronises;
+//! - [`length_byte`]: CO401GW1, command byte, DataLen byte, data; a gap between bytes
+//!   invalidates a frame, a longer pause resynchronises, DataLen >= a threshold is an extension;
+//! - [`start_crc`]: CANopenIA, start byte (with option bits), length, payload, CRC-16.
+//!
+//! Decoders are fed one byte at a time with a millisecond timestamp, never panic, never index
+//! out of bounds, and reject an oversize length before buffering a single data byte.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
+#![cfg_attr(test, allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
+pub mod checksum;
+pub mod crc;
+pub mod length_byte;
+pub mod nibble;
+pub mod start_crc;
+
+/// Milliseconds from a free-running clock. It may wrap; only differences are used.
+pub type Millis = u32;
+
+/// Time from `earlier` to `later` on a wrapping millisecond clock.
+#[inline]
+pub fn elapsed(earlier: Millis, later: Millis) -> u32 {
+    later.wrapping_sub(earlier)
+}
+
+/// A decoded frame, borrowed from the decoder's buffer until the next byte is pushed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Frame<'a> {
+    /// The command code: the high nibble, the command byte, or the first payload byte.
+    pub code: u8,
+    /// A DataLen byte at or above the extension threshold (length-byte framing only).
+    pub length_code: Option<u8>,
+    /// The network number from the start byte (start+CRC framing only).
+    pub network: Option<u8>,
+    /// The data after the command code.
+    pub data: &'a [u8],
+}
+
+/// Why a frame in progress was dropped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameError {
+    /// The gap between two bytes of one frame was longer than the framing allows.
+    Gap,
+    /// The declared length exceeds the framing's or the buffer's maximum.
+    TooLong { declared: u16 },
+    /// The CRC did not match the covered bytes.
+    Crc { received: u16, computed: u16 },
+    /// A start byte with reserved bits set or network 0.
+    BadStart(u8),
+    /// A frame with no command code (empty payload).
+    Empty,
+}
+
+/// Why a frame could not be encoded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EncodeError {
+    /// The output buffer is too small; `needed` bytes are required.
+    BufferTooSmall { needed: usize },
+    /// More data than the framing can carry in one frame.
+    DataTooLong { max: usize },
+    /// The command code does not fit the framing (a nibble framing's code is 0..=15).
+    CodeOutOfRange,
+}
+
+/// A streaming decoder: bytes in, frames out.
+pub trait Deframer {
+    /// Feeds one byte received at `now`. Returns a frame when this byte completes one, or an
+    /// error when this byte shows that the frame in progress is invalid.
+    fn push(&mut self, byte: u8, now: Millis) -> Option<Result<Frame<'_>, FrameError>>;
+    /// Forgets any frame in progress.
+    fn reset(&mut self);
+}
+
+/// Writes `bytes` to the front of `out`, or says how much room was needed.
+fn put(out: &mut [u8], bytes: &[u8]) -> Result<usize, EncodeError> {
+    let dst = out.get_mut(..bytes.len()).ok_or(EncodeError::BufferTooSmall { needed: bytes.len() })?;
+    dst.copy_from_slice(bytes);
+    Ok(bytes.len())
+}
+
+/// What the unit tests collect from a decoder: `(code, length_code or network, data)` or the error.
+#[cfg(test)]
+type Decoded = core::result::Result<(u8, Option<u8>, std::vec::Vec<u8>), FrameError>;
+
+#[cfg(test)]
+extern crate std;
