@@ -1,0 +1,430 @@
+//! Object dictionary interface: entry metadata, access checks per side, SDO abort codes.
+//!
+//! Generated code keeps the data in typed fields and dispatches with a `match`; everything
+//! that decides *whether* an access is allowed lives here, once, so every device and both
+//! sides (bus and host) refuse the same things with the same CiA 301 abort code.
+
+pub use coforge_types::{Access, DataType, HostAccess, NmtState, Storage};
+
+/// CiA 301 SDO abort codes (table 22).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum SdoAbort {
+    ToggleBit = 0x0503_0000,
+    Timeout = 0x0504_0000,
+    UnknownCommand = 0x0504_0001,
+    InvalidBlockSize = 0x0504_0002,
+    InvalidSequence = 0x0504_0003,
+    BlockCrc = 0x0504_0004,
+    OutOfMemory = 0x0504_0005,
+    UnsupportedAccess = 0x0601_0000,
+    WriteOnly = 0x0601_0001,
+    ReadOnly = 0x0601_0002,
+    NoObject = 0x0602_0000,
+    NotMappable = 0x0604_0041,
+    PdoTooLong = 0x0604_0042,
+    IncompatibleParameter = 0x0604_0043,
+    IncompatibleInternal = 0x0604_0047,
+    Hardware = 0x0606_0000,
+    LengthMismatch = 0x0607_0010,
+    LengthTooHigh = 0x0607_0012,
+    LengthTooLow = 0x0607_0013,
+    NoSubIndex = 0x0609_0011,
+    InvalidValue = 0x0609_0030,
+    ValueTooHigh = 0x0609_0031,
+    ValueTooLow = 0x0609_0032,
+    MaxBelowMin = 0x0609_0036,
+    NoResource = 0x060A_0023,
+    General = 0x0800_0000,
+    DataTransfer = 0x0800_0020,
+    DataTransferLocal = 0x0800_0021,
+    DataTransferState = 0x0800_0022,
+    NoDictionary = 0x0800_0023,
+    NoData = 0x0800_0024,
+}
+
+impl SdoAbort {
+    pub const ALL: [SdoAbort; 31] = [
+        SdoAbort::ToggleBit,
+        SdoAbort::Timeout,
+        SdoAbort::UnknownCommand,
+        SdoAbort::InvalidBlockSize,
+        SdoAbort::InvalidSequence,
+        SdoAbort::BlockCrc,
+        SdoAbort::OutOfMemory,
+        SdoAbort::UnsupportedAccess,
+        SdoAbort::WriteOnly,
+        SdoAbort::ReadOnly,
+        SdoAbort::NoObject,
+        SdoAbort::NotMappable,
+        SdoAbort::PdoTooLong,
+        SdoAbort::IncompatibleParameter,
+        SdoAbort::IncompatibleInternal,
+        SdoAbort::Hardware,
+        SdoAbort::LengthMismatch,
+        SdoAbort::LengthTooHigh,
+        SdoAbort::LengthTooLow,
+        SdoAbort::NoSubIndex,
+        SdoAbort::InvalidValue,
+        SdoAbort::ValueTooHigh,
+        SdoAbort::ValueTooLow,
+        SdoAbort::MaxBelowMin,
+        SdoAbort::NoResource,
+        SdoAbort::General,
+        SdoAbort::DataTransfer,
+        SdoAbort::DataTransferLocal,
+        SdoAbort::DataTransferState,
+        SdoAbort::NoDictionary,
+        SdoAbort::NoData,
+    ];
+
+    /// The 32-bit code sent in an SDO abort frame.
+    pub const fn code(self) -> u32 {
+        self as u32
+    }
+
+    pub fn from_code(code: u32) -> Option<SdoAbort> {
+        SdoAbort::ALL.into_iter().find(|a| a.code() == code)
+    }
+}
+
+/// Who accesses the dictionary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// A CANopen master (SDO) or a received PDO.
+    Bus,
+    /// The serial host, through the device's protocol.
+    Host,
+    /// The device's own behaviour code: no access rule applies, only lengths and limits.
+    Device,
+}
+
+/// A set of NMT states, for entries that may only be written in some of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NmtStates(u8);
+
+impl NmtStates {
+    pub const NONE: NmtStates = NmtStates(0);
+    pub const ALL: NmtStates = NmtStates(0b111);
+
+    const fn bit(state: NmtState) -> u8 {
+        match state {
+            NmtState::PreOperational => 0b001,
+            NmtState::Operational => 0b010,
+            NmtState::Stopped => 0b100,
+        }
+    }
+
+    pub const fn with(self, state: NmtState) -> NmtStates {
+        NmtStates(self.0 | Self::bit(state))
+    }
+
+    pub const fn contains(self, state: NmtState) -> bool {
+        self.0 & Self::bit(state) != 0
+    }
+}
+
+/// What a write is judged against besides the entry itself.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AccessContext {
+    pub nmt: NmtState,
+    /// The host has enabled the CANopen interface (CO401GW1's command 0x02).
+    pub can_enabled: bool,
+}
+
+/// Everything the runtime needs to know about one entry; generated from the spec.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EntryInfo {
+    pub index: u16,
+    pub sub: u8,
+    pub data_type: DataType,
+    /// CAN-side access.
+    pub access: Access,
+    /// Serial-host access.
+    pub host_access: HostAccess,
+    /// Host writes are accepted only until the CANopen interface is enabled.
+    pub host_write_before_can_enabled: bool,
+    pub pdo_mappable: bool,
+    pub storage: Storage,
+    /// Size in bytes; for strings and domains the maximum.
+    pub size: u32,
+    pub low: Option<i64>,
+    pub high: Option<i64>,
+    /// If not empty, the only values a write may store.
+    pub values: &'static [i64],
+    /// NMT states in which a bus write is accepted.
+    pub writable_in: NmtStates,
+}
+
+/// How much of a value a read copied, and how long the value is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReadLen {
+    pub copied: usize,
+    pub total: usize,
+}
+
+impl EntryInfo {
+    /// Whether `side` may read this entry, with the abort code if not.
+    pub fn check_read(&self, side: Side) -> Result<(), SdoAbort> {
+        match side {
+            Side::Device => Ok(()),
+            Side::Bus if self.access == Access::None => Err(SdoAbort::NoObject),
+            Side::Bus if !self.access.readable() => Err(SdoAbort::WriteOnly),
+            Side::Host if self.host_access == HostAccess::None => Err(SdoAbort::UnsupportedAccess),
+            Side::Host if !self.host_access.readable() => Err(SdoAbort::WriteOnly),
+            Side::Bus | Side::Host => Ok(()),
+        }
+    }
+
+    /// Whether `side` may write `data` to this entry: access, state, length and value.
+    pub fn check_write(&self, side: Side, ctx: &AccessContext, data: &[u8]) -> Result<(), SdoAbort> {
+        match side {
+            Side::Device => {}
+            Side::Bus => {
+                if self.access == Access::None {
+                    return Err(SdoAbort::NoObject);
+                }
+                if !self.access.writable() {
+                    return Err(SdoAbort::ReadOnly);
+                }
+                if !self.writable_in.contains(ctx.nmt) {
+                    return Err(SdoAbort::DataTransferState);
+                }
+            }
+            Side::Host => {
+                if !self.host_access.writable() {
+                    return Err(if self.host_access == HostAccess::None { SdoAbort::UnsupportedAccess } else { SdoAbort::ReadOnly });
+                }
+                if self.host_write_before_can_enabled && ctx.can_enabled {
+                    return Err(SdoAbort::DataTransferState);
+                }
+            }
+        }
+        self.check_length(data.len())?;
+        self.check_value(data)
+    }
+
+    fn check_length(&self, len: usize) -> Result<(), SdoAbort> {
+        let size = usize::try_from(self.size).unwrap_or(usize::MAX);
+        let variable = matches!(self.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
+        if len > size {
+            Err(SdoAbort::LengthTooHigh)
+        } else if len < size && !variable {
+            Err(SdoAbort::LengthTooLow)
+        } else {
+            Ok(())
+        }
+    }
+
+    fn check_value(&self, data: &[u8]) -> Result<(), SdoAbort> {
+        let Some(value) = decode_int(self.data_type, data) else { return Ok(()) };
+        // Only BOOLEAN can carry bits its type does not allow (a byte holding 2..255).
+        if self.data_type.int_range().is_some_and(|(_, hi)| value > hi) {
+            return Err(SdoAbort::ValueTooHigh);
+        }
+        if !self.values.is_empty() && !self.values.iter().any(|&v| i128::from(v) == value) {
+            return Err(SdoAbort::InvalidValue);
+        }
+        if self.low.is_some_and(|low| value < i128::from(low)) {
+            return Err(SdoAbort::ValueTooLow);
+        }
+        if self.high.is_some_and(|high| value > i128::from(high)) {
+            return Err(SdoAbort::ValueTooHigh);
+        }
+        Ok(())
+    }
+}
+
+/// The value of a little-endian integer entry (BOOLEAN counts as 0/1); `None` for other types
+/// or a length that does not match the type.
+pub fn decode_int(data_type: DataType, data: &[u8]) -> Option<i128> {
+    let (lo, _) = data_type.int_range()?;
+    let bits = data_type.bits()?;
+    let bytes = usize::try_from(bits.div_ceil(8)).ok()?;
+    if data.len() != bytes {
+        return None;
+    }
+    let raw = data.iter().rev().fold(0_u128, |acc, &b| acc << 8 | u128::from(b));
+    let value = raw as i128;
+    // Signed types: sign-extend from the type's width.
+    if lo < 0 && bits < 128 && raw >> (bits - 1) & 1 == 1 { Some(value - (1_i128 << bits)) } else { Some(value) }
+}
+
+/// Copies `value[offset..]` into `buf` (segmented and partial reads).
+pub fn read_slice(value: &[u8], offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+    let rest = value.get(offset..).ok_or(SdoAbort::LengthTooHigh)?;
+    let n = rest.len().min(buf.len());
+    if let (Some(dst), Some(src)) = (buf.get_mut(..n), rest.get(..n)) {
+        dst.copy_from_slice(src);
+    }
+    Ok(ReadLen { copied: n, total: value.len() })
+}
+
+/// Finds an entry in a table sorted by `(index, sub)`: `NoObject` if the index is absent,
+/// `NoSubIndex` if only the sub-index is.
+pub fn find(entries: &[EntryInfo], index: u16, sub: u8) -> Result<&EntryInfo, SdoAbort> {
+    match entries.binary_search_by(|e| (e.index, e.sub).cmp(&(index, sub))) {
+        Ok(i) => entries.get(i).ok_or(SdoAbort::NoObject),
+        Err(i) => {
+            let same_index = |e: &EntryInfo| e.index == index;
+            let near = entries.get(i).is_some_and(same_index) || i.checked_sub(1).and_then(|j| entries.get(j)).is_some_and(same_index);
+            Err(if near { SdoAbort::NoSubIndex } else { SdoAbort::NoObject })
+        }
+    }
+}
+
+/// The dictionary of one device: implemented by the code `device!` generates.
+pub trait ObjectDictionary {
+    /// The entry's metadata, or `NoObject` / `NoSubIndex`.
+    fn entry(&self, index: u16, sub: u8) -> Result<&EntryInfo, SdoAbort>;
+
+    /// Reads the value from byte `offset` into `buf`, after the access check for `side`.
+    fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8], side: Side) -> Result<ReadLen, SdoAbort>;
+
+    /// Writes `data` (the whole value, little-endian) after the checks for `side`. A refused
+    /// write leaves the stored value unchanged.
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side, ctx: &AccessContext) -> Result<(), SdoAbort>;
+}
+
+/// Objects whose data the device keeps outside the dictionary (EEPROM banks, a memory card):
+/// the generated dictionary routes their reads and writes here, after its access checks.
+pub trait AppObjects {
+    fn read(&mut self, entry: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
+    fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const fn info(data_type: DataType, access: Access, host_access: HostAccess, size: u32) -> EntryInfo {
+        EntryInfo {
+            index: 0x2000,
+            sub: 0,
+            data_type,
+            access,
+            host_access,
+            host_write_before_can_enabled: false,
+            pdo_mappable: false,
+            storage: Storage::Ram,
+            size,
+            low: None,
+            high: None,
+            values: &[],
+            writable_in: NmtStates::ALL,
+        }
+    }
+
+    const OP: AccessContext = AccessContext { nmt: NmtState::Operational, can_enabled: true };
+    const PREOP: AccessContext = AccessContext { nmt: NmtState::PreOperational, can_enabled: false };
+
+    #[test]
+    fn abort_codes_are_the_cia_301_values() {
+        assert_eq!(SdoAbort::WriteOnly.code(), 0x0601_0001);
+        assert_eq!(SdoAbort::ReadOnly.code(), 0x0601_0002);
+        assert_eq!(SdoAbort::NoObject.code(), 0x0602_0000);
+        assert_eq!(SdoAbort::NoSubIndex.code(), 0x0609_0011);
+        assert_eq!(SdoAbort::LengthMismatch.code(), 0x0607_0010);
+        assert_eq!(SdoAbort::LengthTooHigh.code(), 0x0607_0012);
+        assert_eq!(SdoAbort::LengthTooLow.code(), 0x0607_0013);
+        assert_eq!(SdoAbort::InvalidValue.code(), 0x0609_0030);
+        assert_eq!(SdoAbort::ValueTooHigh.code(), 0x0609_0031);
+        assert_eq!(SdoAbort::ValueTooLow.code(), 0x0609_0032);
+        assert_eq!(SdoAbort::NotMappable.code(), 0x0604_0041);
+        assert_eq!(SdoAbort::DataTransfer.code(), 0x0800_0020);
+        assert_eq!(SdoAbort::DataTransferState.code(), 0x0800_0022);
+        for a in SdoAbort::ALL {
+            assert_eq!(SdoAbort::from_code(a.code()), Some(a));
+        }
+        assert_eq!(SdoAbort::from_code(0x1234_5678), None);
+    }
+
+    #[test]
+    fn access_differs_by_side() {
+        // CO401GW1 2E00: read-only from CAN, writable by the host.
+        let e = info(DataType::Unsigned8, Access::Ro, HostAccess::Rw, 1);
+        assert_eq!(e.check_write(Side::Bus, &OP, &[1]), Err(SdoAbort::ReadOnly));
+        assert_eq!(e.check_write(Side::Host, &OP, &[1]), Ok(()));
+        assert_eq!(e.check_write(Side::Device, &OP, &[1]), Ok(()));
+        // A write-only CAN entry (CO401Memory1 5E00): readable by the host only.
+        let m = info(DataType::Unsigned8, Access::Wo, HostAccess::Ro, 1);
+        assert_eq!(m.check_read(Side::Bus), Err(SdoAbort::WriteOnly));
+        assert_eq!(m.check_read(Side::Host), Ok(()));
+        assert_eq!(m.check_write(Side::Host, &OP, &[1]), Err(SdoAbort::ReadOnly));
+        // Not reachable from CAN at all (CO401GW1 100B).
+        let n = EntryInfo { host_write_before_can_enabled: true, ..info(DataType::Unsigned8, Access::None, HostAccess::Rw, 1) };
+        assert_eq!(n.check_read(Side::Bus), Err(SdoAbort::NoObject));
+        assert_eq!(n.check_write(Side::Bus, &PREOP, &[5]), Err(SdoAbort::NoObject));
+        assert_eq!(n.check_write(Side::Host, &PREOP, &[5]), Ok(()));
+        assert_eq!(n.check_write(Side::Host, &OP, &[5]), Err(SdoAbort::DataTransferState), "only before the CAN interface is enabled");
+        let h = info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1);
+        assert_eq!(h.check_read(Side::Host), Err(SdoAbort::UnsupportedAccess));
+    }
+
+    #[test]
+    fn writes_restricted_to_nmt_states() {
+        let e = EntryInfo { writable_in: NmtStates::NONE.with(NmtState::PreOperational), ..info(DataType::Unsigned32, Access::Rw, HostAccess::None, 4) };
+        assert_eq!(e.check_write(Side::Bus, &PREOP, &[0; 4]), Ok(()));
+        assert_eq!(e.check_write(Side::Bus, &OP, &[0; 4]), Err(SdoAbort::DataTransferState));
+    }
+
+    #[test]
+    fn lengths_and_values_are_checked() {
+        let e = EntryInfo { low: Some(1), high: Some(127), ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
+        assert_eq!(e.check_write(Side::Bus, &OP, &[]), Err(SdoAbort::LengthTooLow));
+        assert_eq!(e.check_write(Side::Bus, &OP, &[1, 2]), Err(SdoAbort::LengthTooHigh));
+        assert_eq!(e.check_write(Side::Bus, &OP, &[0]), Err(SdoAbort::ValueTooLow));
+        assert_eq!(e.check_write(Side::Bus, &OP, &[128]), Err(SdoAbort::ValueTooHigh));
+        assert_eq!(e.check_write(Side::Device, &OP, &[128]), Err(SdoAbort::ValueTooHigh), "limits bind the device too");
+        let v = EntryInfo { values: &[1, 2, 3, 0x10], ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
+        assert_eq!(v.check_write(Side::Bus, &OP, &[0x10]), Ok(()));
+        assert_eq!(v.check_write(Side::Bus, &OP, &[4]), Err(SdoAbort::InvalidValue));
+        let b = info(DataType::Boolean, Access::Rw, HostAccess::None, 1);
+        assert_eq!(b.check_write(Side::Bus, &OP, &[1]), Ok(()));
+        assert_eq!(b.check_write(Side::Bus, &OP, &[2]), Err(SdoAbort::ValueTooHigh));
+        let s = info(DataType::VisibleString, Access::Rw, HostAccess::None, 8);
+        assert_eq!(s.check_write(Side::Bus, &OP, b"Datei1"), Ok(()), "strings may be shorter than their maximum");
+        assert_eq!(s.check_write(Side::Bus, &OP, b"123456789"), Err(SdoAbort::LengthTooHigh));
+        let i = EntryInfo { low: Some(-100), high: Some(100), ..info(DataType::Integer16, Access::Rw, HostAccess::None, 2) };
+        assert_eq!(i.check_write(Side::Bus, &OP, &(-100_i16).to_le_bytes()), Ok(()));
+        assert_eq!(i.check_write(Side::Bus, &OP, &(-101_i16).to_le_bytes()), Err(SdoAbort::ValueTooLow));
+    }
+
+    #[test]
+    fn integers_decode_little_endian_with_sign() {
+        assert_eq!(decode_int(DataType::Unsigned16, &[0x34, 0x12]), Some(0x1234));
+        assert_eq!(decode_int(DataType::Integer8, &[0xFF]), Some(-1));
+        assert_eq!(decode_int(DataType::Integer24, &[0x00, 0x00, 0x80]), Some(-0x80_0000));
+        assert_eq!(decode_int(DataType::Unsigned64, &[0xFF; 8]), Some(i128::from(u64::MAX)));
+        assert_eq!(decode_int(DataType::Integer64, &[0xFF; 8]), Some(-1));
+        assert_eq!(decode_int(DataType::Unsigned32, &[1, 2]), None);
+        assert_eq!(decode_int(DataType::VisibleString, b"x"), None);
+    }
+
+    #[test]
+    fn find_distinguishes_missing_objects_from_missing_subs() {
+        let table = [
+            EntryInfo { index: 0x1000, sub: 0, ..info(DataType::Unsigned32, Access::Ro, HostAccess::Ro, 4) },
+            EntryInfo { index: 0x1018, sub: 0, ..info(DataType::Unsigned8, Access::Ro, HostAccess::Ro, 1) },
+            EntryInfo { index: 0x1018, sub: 1, ..info(DataType::Unsigned32, Access::Ro, HostAccess::Ro, 4) },
+            EntryInfo { index: 0x1018, sub: 4, ..info(DataType::Unsigned32, Access::Ro, HostAccess::Ro, 4) },
+        ];
+        assert_eq!(find(&table, 0x1018, 4).map(|e| e.sub), Ok(4));
+        assert_eq!(find(&table, 0x1018, 2), Err(SdoAbort::NoSubIndex));
+        assert_eq!(find(&table, 0x1018, 9), Err(SdoAbort::NoSubIndex));
+        assert_eq!(find(&table, 0x1001, 0), Err(SdoAbort::NoObject));
+        assert_eq!(find(&table, 0x0FFF, 0), Err(SdoAbort::NoObject));
+        assert_eq!(find(&table, 0x2000, 0), Err(SdoAbort::NoObject));
+    }
+
+    #[test]
+    fn partial_reads_copy_what_fits() {
+        let mut buf = [0_u8; 4];
+        assert_eq!(read_slice(b"CO401Memory1", 0, &mut buf), Ok(ReadLen { copied: 4, total: 12 }));
+        assert_eq!(&buf, b"CO40");
+        assert_eq!(read_slice(b"CO401Memory1", 8, &mut buf), Ok(ReadLen { copied: 4, total: 12 }));
+        assert_eq!(&buf, b"ory1");
+        assert_eq!(read_slice(b"CO401Memory1", 12, &mut buf), Ok(ReadLen { copied: 0, total: 12 }));
+        assert_eq!(read_slice(b"CO401Memory1", 13, &mut buf), Err(SdoAbort::LengthTooHigh));
+    }
+}
