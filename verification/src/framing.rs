@@ -92,28 +92,54 @@ pub fn prop_start_crc_round_trip(code: u8, data: &[u8]) {
     }
 }
 
-/// A decoder fed any bytes at any times never panics, and every frame it yields fits its
-/// framing. `gaps[i]` is the time before byte `i` (cycled).
-pub fn prop_decoders_total(bytes: &[u8], gaps: &[u8]) {
-    let mut nib = NibbleDecoder::new(MEMORY1);
-    let mut len = LengthByteDecoder::<GW1_MAX>::new(GW1);
-    let mut ia = StartCrcDecoder::<IA_MAX>::new(CANOPENIA);
+/// Time before byte `i`: `gaps` cycled, 1 ms if there are none.
+fn gap_at(gaps: &[u8], i: usize) -> u32 {
+    if gaps.is_empty() { 1 } else { u32::from(gaps.get(i % gaps.len()).copied().unwrap_or(1)) }
+}
+
+/// Feeds any bytes at any times; `check` sees every frame the decoder yields.
+fn drive<D: Deframer>(d: &mut D, bytes: &[u8], gaps: &[u8], mut check: impl FnMut(&Frame<'_>)) {
     let mut t: Millis = 0;
     for (i, &b) in bytes.iter().enumerate() {
-        let gap = if gaps.is_empty() { 1 } else { gaps.get(i % gaps.len()).copied().unwrap_or(1) };
-        t = t.wrapping_add(u32::from(gap));
-        if let Some(Ok(f)) = nib.push(b, t) {
-            assert!(f.code <= 0x0F && f.data.len() <= nibble::MAX_DATA);
-        }
-        if let Some(Ok(f)) = len.push(b, t) {
-            assert!(f.data.len() < usize::from(GW1.extension_threshold));
-            assert!(f.length_code.is_none() || f.data.is_empty());
-        }
-        if let Some(Ok(f)) = ia.push(b, t) {
-            assert!(f.data.len() < IA_MAX);
-            assert!(f.network.is_some_and(|n| (1..=15).contains(&n)));
+        t = t.wrapping_add(gap_at(gaps, i));
+        if let Some(Ok(f)) = d.push(b, t) {
+            check(&f);
         }
     }
+}
+
+/// The nibble decoder never panics on any input, and its frames fit the framing.
+pub fn prop_nibble_total(bytes: &[u8], gaps: &[u8]) {
+    drive(&mut NibbleDecoder::new(MEMORY1), bytes, gaps, |f| assert!(f.code <= 0x0F && f.data.len() <= nibble::MAX_DATA));
+}
+
+/// The length-byte decoder never panics on any input, and its frames fit the framing.
+pub fn prop_length_byte_total(bytes: &[u8], gaps: &[u8]) {
+    drive(&mut LengthByteDecoder::<GW1_MAX>::new(GW1), bytes, gaps, |f| {
+        assert!(f.data.len() < usize::from(GW1.extension_threshold));
+        assert!(f.length_code.is_none() || f.data.is_empty());
+    });
+}
+
+/// The start+CRC decoder never panics on any input, and its frames fit the framing.
+pub fn prop_start_crc_total(bytes: &[u8], gaps: &[u8]) {
+    drive(&mut StartCrcDecoder::<IA_MAX>::new(CANOPENIA), bytes, gaps, |f| {
+        assert!(f.data.len() < IA_MAX);
+        assert!(f.network.is_some_and(|n| (1..=15).contains(&n)));
+    });
+}
+
+/// All three decoders on the same input.
+pub fn prop_decoders_total(bytes: &[u8], gaps: &[u8]) {
+    prop_nibble_total(bytes, gaps);
+    prop_length_byte_total(bytes, gaps);
+    prop_start_crc_total(bytes, gaps);
+}
+
+/// Splits fuzzer input into gaps and bytes: the first byte says how many gaps follow.
+pub fn split_fuzz_input(input: &[u8]) -> (&[u8], &[u8]) {
+    let Some((&n, rest)) = input.split_first() else { return (&[], &[]) };
+    rest.split_at(usize::from(n % 16).min(rest.len()))
 }
 
 /// After any garbage, a pause and then a valid frame decode exactly that frame.

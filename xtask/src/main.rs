@@ -53,7 +53,10 @@ fn specs() -> Result<Vec<PathBuf>> {
 pub fn run(cmd: &mut Command) -> Result {
     let shown = format!("{} {}", cmd.get_program().to_string_lossy(), cmd.get_args().map(|a| a.to_string_lossy()).collect::<Vec<_>>().join(" "));
     println!("xtask: $ {shown}");
-    let status = cmd.current_dir(root()).status().map_err(|e| format!("cannot start `{shown}`: {e}"))?;
+    if cmd.get_current_dir().is_none() {
+        cmd.current_dir(root());
+    }
+    let status = cmd.status().map_err(|e| format!("cannot start `{shown}`: {e}"))?;
     if status.success() { Ok(()) } else { Err(format!("`{shown}` failed ({status})")) }
 }
 
@@ -114,27 +117,27 @@ fn test() -> Result {
     setup::rust_components()?;
     let python = setup::python_venv()?;
 
-    println!("xtask: [1/5] formatting and lints");
+    println!("xtask: [1/6] formatting and lints");
     run(cargo().args(["fmt", "--all", "--check"]))?;
     run(cargo().args(["clippy", "--quiet", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
 
-    println!("xtask: [2/5] Rust tests, and the no_std crates for the smallest target");
+    println!("xtask: [2/6] Rust tests, and the no_std crates for the smallest target");
     run(cargo().args(["test", "--workspace"]))?;
     for krate in NO_STD_CRATES {
         run(cargo().args(["build", "--quiet", "--release", "-p", krate, "--target", "thumbv6m-none-eabi"]))?;
     }
 
-    println!("xtask: [3/5] specs: check and canonical formatting");
+    println!("xtask: [3/6] specs: check and canonical formatting");
     run(cargo().args(["build", "--quiet", "-p", "coforge"]))?;
     let coforge = root().join("target/debug/coforge");
     let spec_args: Vec<PathBuf> = specs()?;
     run(Command::new(&coforge).arg("check").args(&spec_args))?;
     run(Command::new(&coforge).args(["fmt", "--check"]).args(&spec_args))?;
 
-    println!("xtask: [4/5] main outputs build (cargo xtask dist)");
+    println!("xtask: [4/6] main outputs build (cargo xtask dist)");
     dist()?;
 
-    println!("xtask: [5/5] interoperability tests with python-canopen");
+    println!("xtask: [5/6] interoperability tests with python-canopen");
     let status = Command::new(&python)
         .args(["-m", "pytest", "-q", "tests/python"])
         .env("COFORGE_BIN", &coforge)
@@ -147,6 +150,24 @@ fn test() -> Result {
         Some(5) => return Err("pytest collected no tests in tests/python".into()),
         _ => return Err(format!("pytest failed ({status})")),
     }
+    println!("xtask: [6/6] short fuzz runs of every streaming decoder (cargo fuzz)");
+    fuzz()?;
+
     println!("xtask: all tests passed");
+    Ok(())
+}
+
+/// The fuzz targets in `verification/fuzz` (one per streaming decoder).
+const FUZZ_TARGETS: &[&str] = &["nibble_decoder", "length_byte_decoder", "start_crc_decoder"];
+
+/// Runs each fuzz target for `FUZZ_SECONDS` (default 20) seconds; a crash fails the run.
+fn fuzz() -> Result {
+    setup::fuzz_tools()?;
+    let seconds = std::env::var("FUZZ_SECONDS").unwrap_or_else(|_| "20".into());
+    for target in FUZZ_TARGETS {
+        run(Command::new("cargo")
+            .args(["+nightly", "fuzz", "run", target, "--", &format!("-max_total_time={seconds}")])
+            .current_dir(root().join("verification/fuzz")))?;
+    }
     Ok(())
 }

@@ -82,3 +82,17 @@ pub fn python_venv() -> Result<PathBuf> {
     }
     Ok(python)
 }
+
+/// A nightly toolchain and cargo-fuzz, which the fuzz runs need (libFuzzer, sanitizers).
+pub fn fuzz_tools() -> Result {
+    let toolchains = output(Command::new("rustup").args(["toolchain", "list"])).unwrap_or_default();
+    if !toolchains.lines().any(|l| l.starts_with("nightly")) {
+        println!("xtask: installing the nightly Rust toolchain (cargo fuzz builds with libFuzzer and sanitizers)");
+        run(Command::new("rustup").args(["toolchain", "install", "nightly", "--profile", "minimal"]))?;
+    }
+    if output(Command::new("cargo").args(["fuzz", "--version"])).is_none() {
+        println!("xtask: installing cargo-fuzz from crates.io (runs the fuzz targets in verification/fuzz)");
+        run(Command::new("cargo").args(["install", "cargo-fuzz", "--locked"]))?;
+    }
+    Ok(())
+}
