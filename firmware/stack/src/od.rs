@@ -132,11 +132,25 @@ pub struct AccessContext {
     pub can_enabled: bool,
 }
 
-/// Everything the runtime needs to know about one entry; generated from the spec.
+/// Value limits of an entry, kept out of line: most entries have none.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limits {
+    pub low: Option<i64>,
+    pub high: Option<i64>,
+    /// If not empty, the only values a write may store.
+    pub values: &'static [i64],
+}
+
+/// What the runtime knows about an entry, or about a run of identical entries (the 128 bytes
+/// of a memory block share one `EntryInfo` with `sub..=last_sub`), so that the generated
+/// table stays small in flash.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EntryInfo {
     pub index: u16,
+    /// First sub-index this description covers.
     pub sub: u8,
+    /// Last sub-index this description covers (equal to `sub` for a single entry).
+    pub last_sub: u8,
     pub data_type: DataType,
     /// CAN-side access.
     pub access: Access,
@@ -146,14 +160,11 @@ pub struct EntryInfo {
     pub host_write_before_can_enabled: bool,
     pub pdo_mappable: bool,
     pub storage: Storage,
-    /// Size in bytes; for strings and domains the maximum.
-    pub size: u32,
-    pub low: Option<i64>,
-    pub high: Option<i64>,
-    /// If not empty, the only values a write may store.
-    pub values: &'static [i64],
     /// NMT states in which a bus write is accepted.
     pub writable_in: NmtStates,
+    /// Size in bytes; for strings and domains the maximum.
+    pub size: u16,
+    pub limits: Option<&'static Limits>,
 }
 
 /// How much of a value a read copied, and how long the value is.
@@ -204,8 +215,13 @@ impl EntryInfo {
         self.check_value(data)
     }
 
+    /// Whether this description covers `sub`.
+    pub fn covers(&self, sub: u8) -> bool {
+        (self.sub..=self.last_sub).contains(&sub)
+    }
+
     fn check_length(&self, len: usize) -> Result<(), SdoAbort> {
-        let size = usize::try_from(self.size).unwrap_or(usize::MAX);
+        let size = usize::from(self.size);
         let variable = matches!(self.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
         if len > size {
             Err(SdoAbort::LengthTooHigh)
@@ -222,13 +238,14 @@ impl EntryInfo {
         if self.data_type.int_range().is_some_and(|(_, hi)| value > hi) {
             return Err(SdoAbort::ValueTooHigh);
         }
-        if !self.values.is_empty() && !self.values.iter().any(|&v| i128::from(v) == value) {
+        let Some(limits) = self.limits else { return Ok(()) };
+        if !limits.values.is_empty() && !limits.values.iter().any(|&v| i128::from(v) == value) {
             return Err(SdoAbort::InvalidValue);
         }
-        if self.low.is_some_and(|low| value < i128::from(low)) {
+        if limits.low.is_some_and(|low| value < i128::from(low)) {
             return Err(SdoAbort::ValueTooLow);
         }
-        if self.high.is_some_and(|high| value > i128::from(high)) {
+        if limits.high.is_some_and(|high| value > i128::from(high)) {
             return Err(SdoAbort::ValueTooHigh);
         }
         Ok(())
@@ -260,16 +277,17 @@ pub fn read_slice(value: &[u8], offset: usize, buf: &mut [u8]) -> Result<ReadLen
     Ok(ReadLen { copied: n, total: value.len() })
 }
 
-/// Finds an entry in a table sorted by `(index, sub)`: `NoObject` if the index is absent,
-/// `NoSubIndex` if only the sub-index is.
+/// Finds the description of `index`/`sub` in a table sorted by `(index, sub)` whose runs do
+/// not overlap: `NoObject` if the index is absent, `NoSubIndex` if only the sub-index is.
 pub fn find(entries: &[EntryInfo], index: u16, sub: u8) -> Result<&EntryInfo, SdoAbort> {
-    match entries.binary_search_by(|e| (e.index, e.sub).cmp(&(index, sub))) {
-        Ok(i) => entries.get(i).ok_or(SdoAbort::NoObject),
-        Err(i) => {
-            let same_index = |e: &EntryInfo| e.index == index;
-            let near = entries.get(i).is_some_and(same_index) || i.checked_sub(1).and_then(|j| entries.get(j)).is_some_and(same_index);
-            Err(if near { SdoAbort::NoSubIndex } else { SdoAbort::NoObject })
-        }
+    // The last run that starts at or before (index, sub).
+    let after = entries.partition_point(|e| (e.index, e.sub) <= (index, sub));
+    let candidate = after.checked_sub(1).and_then(|i| entries.get(i));
+    match candidate {
+        Some(e) if e.index == index && e.covers(sub) => Ok(e),
+        Some(e) if e.index == index => Err(SdoAbort::NoSubIndex),
+        _ if entries.get(after).is_some_and(|e| e.index == index) => Err(SdoAbort::NoSubIndex),
+        _ => Err(SdoAbort::NoObject),
     }
 }
 
@@ -297,21 +315,20 @@ pub trait AppObjects {
 mod tests {
     use super::*;
 
-    const fn info(data_type: DataType, access: Access, host_access: HostAccess, size: u32) -> EntryInfo {
+    const fn info(data_type: DataType, access: Access, host_access: HostAccess, size: u16) -> EntryInfo {
         EntryInfo {
             index: 0x2000,
             sub: 0,
+            last_sub: 0,
             data_type,
             access,
             host_access,
             host_write_before_can_enabled: false,
             pdo_mappable: false,
             storage: Storage::Ram,
-            size,
-            low: None,
-            high: None,
-            values: &[],
             writable_in: NmtStates::ALL,
+            size,
+            limits: None,
         }
     }
 
@@ -370,13 +387,15 @@ mod tests {
 
     #[test]
     fn lengths_and_values_are_checked() {
-        let e = EntryInfo { low: Some(1), high: Some(127), ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
+        static NODE_ID: Limits = Limits { low: Some(1), high: Some(127), values: &[] };
+        let e = EntryInfo { limits: Some(&NODE_ID), ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
         assert_eq!(e.check_write(Side::Bus, &OP, &[]), Err(SdoAbort::LengthTooLow));
         assert_eq!(e.check_write(Side::Bus, &OP, &[1, 2]), Err(SdoAbort::LengthTooHigh));
         assert_eq!(e.check_write(Side::Bus, &OP, &[0]), Err(SdoAbort::ValueTooLow));
         assert_eq!(e.check_write(Side::Bus, &OP, &[128]), Err(SdoAbort::ValueTooHigh));
         assert_eq!(e.check_write(Side::Device, &OP, &[128]), Err(SdoAbort::ValueTooHigh), "limits bind the device too");
-        let v = EntryInfo { values: &[1, 2, 3, 0x10], ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
+        static MODES: Limits = Limits { low: None, high: None, values: &[1, 2, 3, 0x10] };
+        let v = EntryInfo { limits: Some(&MODES), ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
         assert_eq!(v.check_write(Side::Bus, &OP, &[0x10]), Ok(()));
         assert_eq!(v.check_write(Side::Bus, &OP, &[4]), Err(SdoAbort::InvalidValue));
         let b = info(DataType::Boolean, Access::Rw, HostAccess::None, 1);
@@ -385,7 +404,8 @@ mod tests {
         let s = info(DataType::VisibleString, Access::Rw, HostAccess::None, 8);
         assert_eq!(s.check_write(Side::Bus, &OP, b"Datei1"), Ok(()), "strings may be shorter than their maximum");
         assert_eq!(s.check_write(Side::Bus, &OP, b"123456789"), Err(SdoAbort::LengthTooHigh));
-        let i = EntryInfo { low: Some(-100), high: Some(100), ..info(DataType::Integer16, Access::Rw, HostAccess::None, 2) };
+        static SIGNED: Limits = Limits { low: Some(-100), high: Some(100), values: &[] };
+        let i = EntryInfo { limits: Some(&SIGNED), ..info(DataType::Integer16, Access::Rw, HostAccess::None, 2) };
         assert_eq!(i.check_write(Side::Bus, &OP, &(-100_i16).to_le_bytes()), Ok(()));
         assert_eq!(i.check_write(Side::Bus, &OP, &(-101_i16).to_le_bytes()), Err(SdoAbort::ValueTooLow));
     }
@@ -403,18 +423,33 @@ mod tests {
 
     #[test]
     fn find_distinguishes_missing_objects_from_missing_subs() {
-        let table = [
-            EntryInfo { index: 0x1000, sub: 0, ..info(DataType::Unsigned32, Access::Ro, HostAccess::Ro, 4) },
-            EntryInfo { index: 0x1018, sub: 0, ..info(DataType::Unsigned8, Access::Ro, HostAccess::Ro, 1) },
-            EntryInfo { index: 0x1018, sub: 1, ..info(DataType::Unsigned32, Access::Ro, HostAccess::Ro, 4) },
-            EntryInfo { index: 0x1018, sub: 4, ..info(DataType::Unsigned32, Access::Ro, HostAccess::Ro, 4) },
-        ];
+        let at = |index, sub, last_sub| EntryInfo { index, sub, last_sub, ..info(DataType::Unsigned8, Access::Ro, HostAccess::Ro, 1) };
+        // 1000; 1018 subs 0, 1, 4; a memory block 5000 with sub 0 and the run 1..=128.
+        let table = [at(0x1000, 0, 0), at(0x1018, 0, 0), at(0x1018, 1, 1), at(0x1018, 4, 4), at(0x5000, 0, 0), at(0x5000, 1, 128)];
         assert_eq!(find(&table, 0x1018, 4).map(|e| e.sub), Ok(4));
         assert_eq!(find(&table, 0x1018, 2), Err(SdoAbort::NoSubIndex));
         assert_eq!(find(&table, 0x1018, 9), Err(SdoAbort::NoSubIndex));
+        assert_eq!(find(&table, 0x5000, 77).map(|e| (e.sub, e.last_sub)), Ok((1, 128)));
+        assert_eq!(find(&table, 0x5000, 128).map(|e| e.sub), Ok(1));
+        assert_eq!(find(&table, 0x5000, 129), Err(SdoAbort::NoSubIndex));
         assert_eq!(find(&table, 0x1001, 0), Err(SdoAbort::NoObject));
         assert_eq!(find(&table, 0x0FFF, 0), Err(SdoAbort::NoObject));
-        assert_eq!(find(&table, 0x2000, 0), Err(SdoAbort::NoObject));
+        assert_eq!(find(&table, 0x6000, 0), Err(SdoAbort::NoObject));
+        let no_sub0 = [at(0x6000, 1, 8)];
+        assert_eq!(find(&no_sub0, 0x6000, 0), Err(SdoAbort::NoSubIndex));
+        // Every sub-index of every present index resolves as the table says.
+        for index in [0x1000_u16, 0x1018, 0x5000] {
+            for sub in 0..=255_u8 {
+                let want = table.iter().find(|e| e.index == index && e.covers(sub));
+                assert_eq!(find(&table, index, sub).ok(), want, "{index:04X}.{sub}");
+            }
+        }
+    }
+
+    #[test]
+    fn entry_info_is_small_enough_for_flash_tables() {
+        // 8 KiB of CO401Memory1 memory blocks take 128 runs; each must stay a few words.
+        assert!(core::mem::size_of::<EntryInfo>() <= 24, "{}", core::mem::size_of::<EntryInfo>());
     }
 
     #[test]
