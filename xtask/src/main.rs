@@ -33,7 +33,7 @@ fn main() -> ExitCode {
 pub type Result<T = ()> = std::result::Result<T, String>;
 
 /// Firmware crates that must build for `thumbv6m-none-eabi` (Cortex-M0, no atomics).
-const NO_STD_CRATES: &[&str] = &["coforge-types", "coforge-link", "coforge-stack"];
+const NO_STD_CRATES: &[&str] = &["coforge-types", "coforge-link", "coforge-stack", "co401memory1", "co401gw1", "cr3101", "canopenia"];
 
 pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").canonicalize().unwrap_or_else(|_| PathBuf::from(".."))

@@ -44,6 +44,8 @@ enum Cmd {
         #[arg(long)]
         mode: Option<String>,
     },
+    /// Print the Rust code `device!` generates for a spec, formatted.
+    Dump { spec: PathBuf },
     /// Decode one serial frame (hex bytes) by a spec's framing and command table.
     Decode {
         spec: PathBuf,
@@ -145,6 +147,13 @@ fn run(cmd: Cmd) -> Result<ExitCode, String> {
             let device = loaded.device().ok_or("spec did not load")?;
             let json = coforge_spec::eds::model_json(device, mode.as_deref(), node_id).map_err(|e| e.to_string())?;
             write_output(None, &format!("{json}\n"))?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Dump { spec } => {
+            let Some(loaded) = load_reporting(&spec) else { return Ok(ExitCode::FAILURE) };
+            let device = loaded.device().ok_or("spec did not load")?;
+            let code = coforge_codegen::pretty(coforge_codegen::generate(device, &coforge_codegen::Options::default()))?;
+            write_output(None, &code)?;
             Ok(ExitCode::SUCCESS)
         }
         Cmd::Decode { spec, bytes, from } => {

@@ -1,0 +1,189 @@
+//! `od::entries(mode)`: the sorted entry metadata table of each mode.
+
+use crate::Options;
+use crate::modes::Modes;
+use coforge_spec::model::{Device, Entry, Object, Value, in_mode};
+use coforge_spec::types::{DataType, NmtState, WriteWhen};
+use proc_macro2::{Ident, Span, TokenStream};
+use quote::{format_ident, quote};
+
+/// Value limits of an entry: (low, high, allowed values).
+type LimitsKey = (Option<i64>, Option<i64>, Vec<i64>);
+
+/// One `EntryInfo`: an entry, or a run of consecutive sub-entries that describe alike.
+#[derive(Debug, Clone, PartialEq)]
+struct Run {
+    index: u16,
+    sub: u8,
+    last_sub: u8,
+    meta: Meta,
+}
+
+/// Everything but the sub-index; equal metadata on consecutive subs forms a run.
+#[derive(Debug, Clone, PartialEq)]
+struct Meta {
+    data_type: DataType,
+    access: String,
+    host_access: String,
+    host_write_before_can_enabled: bool,
+    pdo_mappable: bool,
+    storage: String,
+    writable_in: Option<Vec<NmtState>>,
+    size: u16,
+    limits: Option<LimitsKey>,
+}
+
+/// Bytes an entry holds; strings and domains: their maximum.
+fn size_of(e: &Entry) -> u16 {
+    let bytes = match (e.data_type.bits(), e.length, &e.default) {
+        (Some(bits), _, _) => bits.div_ceil(8),
+        (None, Some(len), _) => len,
+        (None, None, Some(Value::Str(s))) => u32::try_from(s.len()).unwrap_or(u32::MAX),
+        // A domain without a declared length: as much as a transfer brings.
+        (None, None, _) => u32::from(u16::MAX),
+    };
+    u16::try_from(bytes).unwrap_or(u16::MAX)
+}
+
+fn meta(e: &Entry) -> Meta {
+    let int = |v: &Option<Value>| v.as_ref().and_then(|v| v.int_for(1));
+    let (low, high) = (int(&e.low), int(&e.high));
+    let values = e.values.clone().unwrap_or_default();
+    Meta {
+        data_type: e.data_type,
+        access: format!("{:?}", e.access),
+        host_access: format!("{:?}", e.host_access),
+        host_write_before_can_enabled: e.host_write_when == WriteWhen::BeforeCanEnabled,
+        pdo_mappable: e.pdo_mapping,
+        storage: format!("{:?}", e.storage),
+        writable_in: e.writable_in.clone(),
+        size: size_of(e),
+        limits: (low.is_some() || high.is_some() || !values.is_empty()).then_some((low, high, values)),
+    }
+}
+
+/// The runs of one mode, sorted by (index, sub).
+fn runs(d: &Device, mode: Option<&str>) -> Vec<Run> {
+    let mut out: Vec<Run> = Vec::new();
+    for o in d.objects.iter().filter(|o: &&Object| in_mode(&o.modes, mode)) {
+        let mut entries: Vec<&Entry> = o.entries.iter().filter(|e| in_mode(&e.modes, mode)).collect();
+        entries.sort_by_key(|e| e.sub);
+        for e in entries {
+            let m = meta(e);
+            match out.last_mut() {
+                Some(last) if last.index == o.index && u16::from(last.last_sub) + 1 == u16::from(e.sub) && last.meta == m => last.last_sub = e.sub,
+                _ => out.push(Run { index: o.index, sub: e.sub, last_sub: e.sub, meta: m }),
+            }
+        }
+    }
+    out
+}
+
+fn ident(name: &str) -> Ident {
+    Ident::new(name, Span::call_site())
+}
+
+fn run_tokens(r: &Run, stack: &TokenStream, limits: &mut Vec<LimitsKey>) -> TokenStream {
+    let Run { index, sub, last_sub, meta: m } = r;
+    let index = crate::hex((*index).into(), 4);
+    let (sub, last_sub) = (crate::dec((*sub).into()), crate::dec((*last_sub).into()));
+    let data_type = ident(&format!("{:?}", m.data_type));
+    let access = ident(&m.access);
+    let host_access = ident(&m.host_access);
+    let storage = ident(&m.storage);
+    let (before, pdo, size) = (m.host_write_before_can_enabled, m.pdo_mappable, crate::dec(m.size.into()));
+    let writable_in = match &m.writable_in {
+        None => quote!(#stack::od::NmtStates::ALL),
+        Some(states) => {
+            let states = states.iter().map(|s| ident(&format!("{s:?}")));
+            quote!(#stack::od::NmtStates::NONE #(.with(#stack::od::NmtState::#states))*)
+        }
+    };
+    let limits = match &m.limits {
+        None => quote!(None),
+        Some(key) => {
+            let n = limits.iter().position(|k| k == key).unwrap_or_else(|| {
+                limits.push(key.clone());
+                limits.len() - 1
+            });
+            let name = format_ident!("LIMITS_{}", n);
+            quote!(Some(&#name))
+        }
+    };
+    quote! {
+        #stack::od::EntryInfo {
+            index: #index,
+            sub: #sub,
+            last_sub: #last_sub,
+            data_type: #stack::od::DataType::#data_type,
+            access: #stack::od::Access::#access,
+            host_access: #stack::od::HostAccess::#host_access,
+            host_write_before_can_enabled: #before,
+            pdo_mappable: #pdo,
+            storage: #stack::od::Storage::#storage,
+            writable_in: #writable_in,
+            size: #size,
+            limits: #limits,
+        }
+    }
+}
+
+pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
+    let stack = &options.stack;
+    let mut limits: Vec<LimitsKey> = Vec::new();
+    let mut tables = Vec::new();
+    let mut per_mode = Vec::new();
+    for (variant, mode) in &modes.variants {
+        let runs = runs(d, mode.as_deref());
+        let count = crate::dec(runs.len() as u64);
+        let table = format_ident!("ENTRIES_{}", variant.to_string().to_uppercase());
+        let items: Vec<TokenStream> = runs.iter().map(|r| run_tokens(r, stack, &mut limits)).collect();
+        tables.push(quote! { static #table: [#stack::od::EntryInfo; #count] = [#(#items),*]; });
+        per_mode.push(quote!(&#table));
+    }
+    let limit_statics = limits.iter().enumerate().map(|(n, (low, high, values))| {
+        let name = format_ident!("LIMITS_{}", n);
+        let opt = |v: &Option<i64>| match v {
+            Some(v) => {
+                let v = proc_macro2::Literal::i64_unsuffixed(*v);
+                quote!(Some(#v))
+            }
+            None => quote!(None),
+        };
+        let values = values.iter().map(|v| proc_macro2::Literal::i64_unsuffixed(*v));
+        let (low, high) = (opt(low), opt(high));
+        quote! { static #name: #stack::od::Limits = #stack::od::Limits { low: #low, high: #high, values: &[#(#values),*] }; }
+    });
+    let select = modes.select(&per_mode);
+    quote! {
+        /// Object dictionary metadata, generated from the spec.
+        pub mod od {
+            use super::Mode;
+            #(#limit_statics)*
+            #(#tables)*
+            /// Every entry of `mode`, sorted by index and sub-index; consecutive sub-entries that
+            /// are described alike share one run (`sub..=last_sub`).
+            pub fn entries(mode: Mode) -> &'static [#stack::od::EntryInfo] {
+                #select
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_blocks_collapse_into_two_runs_each() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../spec/co401memory1.yaml");
+        let d = coforge_spec::load_file(&path).into_device().expect("spec loads");
+        let runs = runs(&d, None);
+        let block: Vec<&Run> = runs.iter().filter(|r| r.index == 0x5000).collect();
+        assert_eq!(block.iter().map(|r| (r.sub, r.last_sub)).collect::<Vec<_>>(), [(0, 0), (1, 128)]);
+        // Sorted, and runs never overlap.
+        assert!(runs.windows(2).all(|w| (w[0].index, w[0].last_sub) < (w[1].index, w[1].sub)));
+        let entries: usize = d.objects.iter().map(|o| o.entries.len()).sum();
+        assert!(runs.len() * 20 < entries, "{} runs for {entries} entries", runs.len());
+    }
+}

@@ -1,0 +1,7 @@
+//! The canopenia device: its object dictionary tables and default PDOs, generated from
+//! `spec/canopenia.yaml`. The device's behaviour comes with its own issue.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(warnings)]
+
+coforge_macros::device!("../../../spec/canopenia.yaml");

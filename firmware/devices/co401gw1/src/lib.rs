@@ -1,0 +1,7 @@
+//! The co401gw1 device: its object dictionary tables and default PDOs, generated from
+//! `spec/co401gw1.yaml`. The device's behaviour comes with its own issue.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(warnings)]
+
+coforge_macros::device!("../../../spec/co401gw1.yaml");
