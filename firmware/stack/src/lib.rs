@@ -11,3 +11,4 @@
 
 pub mod od;
 pub mod pdo;
+pub mod value;

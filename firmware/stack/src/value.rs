@@ -1,0 +1,153 @@
+//! How typed dictionary fields are read and written as little-endian bytes.
+
+use crate::od::{EntryInfo, ReadLen, SdoAbort, decode_int, read_slice};
+
+/// A value stored in a dictionary field. `write` gets data that already passed the access,
+/// length and range checks of [`EntryInfo::check_write`].
+pub trait OdValue {
+    fn read(&self, entry: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
+    fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort>;
+}
+
+macro_rules! integer_value {
+    ($($t:ty),*) => {$(
+        impl OdValue for $t {
+            fn read(&self, entry: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+                let bytes = self.to_le_bytes();
+                // 24/40/48/56-bit types live in the next wider Rust integer.
+                read_slice(bytes.get(..usize::from(entry.size)).unwrap_or(&bytes), offset, buf)
+            }
+            fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
+                let value = decode_int(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)?;
+                *self = <$t>::try_from(value).map_err(|_| SdoAbort::ValueTooHigh)?;
+                Ok(())
+            }
+        }
+    )*};
+}
+
+integer_value!(u8, u16, u32, u64, i8, i16, i32, i64);
+
+impl OdValue for bool {
+    fn read(&self, _: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        read_slice(&[u8::from(*self)], offset, buf)
+    }
+    fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
+        *self = decode_int(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)? != 0;
+        Ok(())
+    }
+}
+
+macro_rules! float_value {
+    ($($t:ty),*) => {$(
+        impl OdValue for $t {
+            fn read(&self, _: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+                read_slice(&self.to_le_bytes(), offset, buf)
+            }
+            fn write(&mut self, _: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
+                *self = <$t>::from_le_bytes(data.try_into().map_err(|_| SdoAbort::LengthMismatch)?);
+                Ok(())
+            }
+        }
+    )*};
+}
+
+float_value!(f32, f64);
+
+/// A string or octet string of at most `N` bytes, stored without heap.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Bytes<const N: usize> {
+    bytes: [u8; N],
+    len: usize,
+}
+
+impl<const N: usize> Bytes<N> {
+    /// The spec's default text; longer text is cut at `N` (the spec check prevents that).
+    // Indexing in a const loop bounded by both lengths; `get` is not usable in const here.
+    #[allow(clippy::indexing_slicing)]
+    pub const fn new(text: &str) -> Self {
+        let src = text.as_bytes();
+        let mut bytes = [0_u8; N];
+        let mut i = 0;
+        while i < src.len() && i < N {
+            bytes[i] = src[i];
+            i += 1;
+        }
+        Bytes { bytes, len: i }
+    }
+
+    pub fn as_bytes(&self) -> &[u8] {
+        self.bytes.get(..self.len).unwrap_or(&[])
+    }
+}
+
+impl<const N: usize> OdValue for Bytes<N> {
+    fn read(&self, _: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        read_slice(self.as_bytes(), offset, buf)
+    }
+    fn write(&mut self, _: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
+        let dst = self.bytes.get_mut(..data.len()).ok_or(SdoAbort::LengthTooHigh)?;
+        dst.copy_from_slice(data);
+        self.len = data.len();
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::od::{Access, DataType, HostAccess, NmtStates, Storage};
+
+    fn info(data_type: DataType, size: u16) -> EntryInfo {
+        EntryInfo {
+            index: 0x2000,
+            sub: 0,
+            last_sub: 0,
+            data_type,
+            access: Access::Rw,
+            host_access: HostAccess::None,
+            host_write_before_can_enabled: false,
+            pdo_mappable: false,
+            storage: Storage::Ram,
+            writable_in: NmtStates::ALL,
+            size,
+            limits: None,
+        }
+    }
+
+    #[test]
+    fn integers_round_trip_little_endian() {
+        let e = info(DataType::Integer24, 3);
+        let mut v: i32 = 0;
+        v.write(&e, &[0xFE, 0xFF, 0xFF]).unwrap();
+        assert_eq!(v, -2);
+        let mut buf = [0; 8];
+        assert_eq!(v.read(&e, 0, &mut buf), Ok(ReadLen { copied: 3, total: 3 }));
+        assert_eq!(buf[..3], [0xFE, 0xFF, 0xFF]);
+        let mut u: u16 = 0;
+        u.write(&info(DataType::Unsigned16, 2), &[0x34, 0x12]).unwrap();
+        assert_eq!(u, 0x1234);
+    }
+
+    #[test]
+    fn strings_keep_their_length() {
+        let e = info(DataType::VisibleString, 8);
+        let mut s = Bytes::<8>::new("Datei1");
+        assert_eq!(s.as_bytes(), b"Datei1");
+        s.write(&e, b"oil").unwrap();
+        let mut buf = [0; 8];
+        assert_eq!(s.read(&e, 0, &mut buf), Ok(ReadLen { copied: 3, total: 3 }));
+        assert_eq!(s.write(&e, b"123456789"), Err(SdoAbort::LengthTooHigh));
+        assert_eq!(s.as_bytes(), b"oil", "a refused write keeps the stored value");
+    }
+
+    #[test]
+    fn floats_and_booleans() {
+        let mut f: f32 = 0.0;
+        f.write(&info(DataType::Real32, 4), &1.5_f32.to_le_bytes()).unwrap();
+        assert_eq!(f, 1.5);
+        let mut b = false;
+        b.write(&info(DataType::Boolean, 1), &[1]).unwrap();
+        assert!(b);
+    }
+}
