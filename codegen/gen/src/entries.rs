@@ -34,7 +34,7 @@ struct Meta {
 }
 
 /// Bytes an entry holds; strings and domains: their maximum.
-fn size_of(e: &Entry) -> u16 {
+pub(crate) fn size_of(e: &Entry) -> u16 {
     let bytes = match (e.data_type.bits(), e.length, &e.default) {
         (Some(bits), _, _) => bits.div_ceil(8),
         (None, Some(len), _) => len,

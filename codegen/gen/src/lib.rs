@@ -13,6 +13,7 @@
 //! [`EntryInfo`]: https://docs.rs/coforge-stack
 #![forbid(unsafe_code)]
 
+mod dictionary;
 mod entries;
 mod modes;
 mod pdos;
@@ -56,6 +57,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
     let profile = dec(id.profile.into());
     let od = entries::od_module(device, &modes, options);
     let pdo = pdos::pdo_module(device, &modes, options);
+    let dictionary = dictionary::dictionary(device, options);
     quote! {
         /// Device name from the spec.
         pub const NAME: &str = #name;
@@ -67,6 +69,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
         #mode_enum
         #od
         #pdo
+        #dictionary
     }
 }
 

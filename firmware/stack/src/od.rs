@@ -306,9 +306,23 @@ pub trait ObjectDictionary {
 
 /// Objects whose data the device keeps outside the dictionary (EEPROM banks, a memory card):
 /// the generated dictionary routes their reads and writes here, after its access checks.
+/// `entry` may describe a run of sub-indices; `sub` is the one accessed.
 pub trait AppObjects {
-    fn read(&mut self, entry: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
-    fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort>;
+    fn read(&mut self, entry: &EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
+    fn write(&mut self, entry: &EntryInfo, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
+}
+
+/// For devices without app-backed objects: nothing is routed here.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct NoAppObjects;
+
+impl AppObjects for NoAppObjects {
+    fn read(&mut self, _: &EntryInfo, _: u8, _: usize, _: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        Err(SdoAbort::NoObject)
+    }
+    fn write(&mut self, _: &EntryInfo, _: u8, _: &[u8]) -> Result<(), SdoAbort> {
+        Err(SdoAbort::NoObject)
+    }
 }
 
 #[cfg(test)]

@@ -151,3 +151,10 @@ mod tests {
         assert!(b);
     }
 }
+
+/// An ARRAY object's storage: sub 0 and the elements 1..=N.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Array<T, const N: usize> {
+    pub sub0: u8,
+    pub items: [T; N],
+}
