@@ -17,6 +17,7 @@ mod dictionary;
 mod entries;
 mod modes;
 mod pdos;
+mod serial;
 
 use coforge_spec::Device;
 use proc_macro2::{Literal, Span, TokenStream};
@@ -58,6 +59,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
     let od = entries::od_module(device, &modes, options);
     let pdo = pdos::pdo_module(device, &modes, options);
     let dictionary = dictionary::dictionary(device, options);
+    let serial = serial::serial_module(device, options);
     quote! {
         /// Device name from the spec.
         pub const NAME: &str = #name;
@@ -70,6 +72,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
         #od
         #pdo
         #dictionary
+        #serial
     }
 }
 

@@ -15,6 +15,7 @@
 
 pub mod checksum;
 pub mod crc;
+pub mod fields;
 pub mod length_byte;
 pub mod nibble;
 pub mod start_crc;

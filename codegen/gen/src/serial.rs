@@ -1,0 +1,308 @@
+//! `serial`: the framing's configuration and decoder, and per direction an enum of the
+//! protocol's commands with typed fields, `decode(&Frame)` and `encode(&mut [u8])`.
+
+use crate::Options;
+use coforge_spec::model::{Command, Device, Direction, FieldType, Framing, LengthCounts};
+use proc_macro2::{Ident, Span, TokenStream};
+use quote::{format_ident, quote};
+
+fn camel(name: &str) -> Ident {
+    let s: String = name.split('_').filter(|p| !p.is_empty()).map(|p| p[..1].to_ascii_uppercase() + &p[1..]).collect();
+    Ident::new(&s, Span::call_site())
+}
+
+fn field_ident(name: &str) -> Ident {
+    match name {
+        "type" | "ref" | "mod" | "match" | "fn" | "struct" | "enum" | "use" | "in" | "as" | "const" | "static" | "loop" | "move" | "box" | "self" | "super"
+        | "crate" => format_ident!("r#{}", name),
+        _ => Ident::new(name, Span::call_site()),
+    }
+}
+
+/// The Rust type of a field and whether it borrows the frame.
+fn field_type(ty: FieldType, signed: bool) -> (TokenStream, bool) {
+    match (ty, signed) {
+        (FieldType::Unsigned(1), _) => (quote!(u8), false),
+        (FieldType::Unsigned(2), _) => (quote!(u16), false),
+        (FieldType::Unsigned(_), _) => (quote!(u32), false),
+        (FieldType::Signed(1), _) => (quote!(i8), false),
+        (FieldType::Signed(2), _) => (quote!(i16), false),
+        (FieldType::Signed(_), _) => (quote!(i32), false),
+        (FieldType::Bytes(n), _) => {
+            let n = crate::dec(n.into());
+            (quote!([u8; #n]), false)
+        }
+        (FieldType::Tail { .. }, _) => (quote!(&'a [u8]), true),
+    }
+}
+
+fn framing_tokens(framing: &Framing, max_data: usize) -> (TokenStream, TokenStream, TokenStream) {
+    let link = quote!(::coforge_link);
+    match framing {
+        Framing::NibbleLength { resync_pause_ms } => (
+            quote! {
+                pub const FRAMING: #link::nibble::NibbleConfig = #link::nibble::NibbleConfig { resync_pause_ms: #resync_pause_ms };
+                /// The streaming decoder of this protocol.
+                pub type Decoder = #link::nibble::NibbleDecoder;
+            },
+            quote!(#link::nibble::encode(code, data, out)),
+            quote!(Decoder::new(FRAMING)),
+        ),
+        Framing::LengthByte { inter_byte_timeout_ms, resync_pause_ms, extension_threshold } => {
+            let n = crate::dec(max_data.max(1) as u64);
+            (
+                quote! {
+                    pub const FRAMING: #link::length_byte::LengthByteConfig = #link::length_byte::LengthByteConfig {
+                        inter_byte_timeout_ms: #inter_byte_timeout_ms,
+                        resync_pause_ms: #resync_pause_ms,
+                        extension_threshold: #extension_threshold,
+                    };
+                    /// The streaming decoder of this protocol, sized for its longest command.
+                    pub type Decoder = #link::length_byte::LengthByteDecoder<#n>;
+                },
+                quote! {
+                    match length_code {
+                        Some(x) => #link::length_byte::encode_extension(&FRAMING, code, x, out),
+                        None => #link::length_byte::encode(&FRAMING, code, data, out),
+                    }
+                },
+                quote!(Decoder::new(FRAMING)),
+            )
+        }
+        Framing::StartLengthCrc { start_byte, start_bits, length_bytes, length_counts, max_payload, crc } => {
+            let (poly, init, xor) = (crate::hex(crc.poly, 4), crate::hex(crc.init, 4), crate::hex(crc.xor_out, 4));
+            let (refin, refout, le, cs, cl) = (crc.reflect_in, crc.reflect_out, crc.little_endian, crc.covers_start, crc.covers_length);
+            let bits = match start_bits {
+                Some(b) => {
+                    let (n, c, l) = (crate::hex(b.network.into(), 2), crate::hex(b.crc.into(), 2), crate::hex(b.long_length.into(), 2));
+                    quote!(Some(#link::start_crc::StartBits { network: #n, crc: #c, long_length: #l }))
+                }
+                None => quote!(None),
+            };
+            let counts = match length_counts {
+                LengthCounts::Payload => quote!(Payload),
+                LengthCounts::PayloadAndCrc => quote!(PayloadAndCrc),
+                LengthCounts::Frame => quote!(Frame),
+            };
+            let start = crate::hex((*start_byte).into(), 2);
+            let n = crate::dec((*max_payload).into());
+            (
+                quote! {
+                    static CRC: #link::crc::Crc16 = #link::crc::Crc16::new(#link::crc::CrcParams { poly: #poly, init: #init, reflect_in: #refin, reflect_out: #refout, xor_out: #xor });
+                    pub const FRAMING: #link::start_crc::StartCrcConfig = #link::start_crc::StartCrcConfig {
+                        start_byte: #start,
+                        start_bits: #bits,
+                        length_bytes: #length_bytes,
+                        length_counts: #link::start_crc::LengthCounts::#counts,
+                        max_payload: #max_payload,
+                        crc: &CRC,
+                        crc_little_endian: #le,
+                        crc_covers_start: #cs,
+                        crc_covers_length: #cl,
+                        inter_byte_timeout_ms: None,
+                    };
+                    /// The streaming decoder of this protocol, sized for its largest payload.
+                    pub type Decoder = #link::start_crc::StartCrcDecoder<#n>;
+                },
+                quote!(#link::start_crc::encode(&FRAMING, code, data, out)),
+                quote!(Decoder::new(FRAMING)),
+            )
+        }
+    }
+}
+
+/// How a field is read from `data` and written to `buf`.
+fn field_codec(ty: FieldType, at: u32, big_endian: bool, name: &Ident) -> (TokenStream, TokenStream) {
+    let link = quote!(::coforge_link::fields);
+    let at_l = crate::dec(at.into());
+    match ty {
+        FieldType::Unsigned(n) => {
+            let n = crate::dec(n.into());
+            let (rt, _) = field_type(ty, false);
+            (quote!(#link::read_uint(data, #at_l, #n, #big_endian) as #rt), quote!(#link::write_uint(&mut buf, #at_l, #n, #big_endian, u64::from(*#name))))
+        }
+        FieldType::Signed(n) => {
+            let n = crate::dec(n.into());
+            let (rt, _) = field_type(ty, true);
+            (
+                quote!(#link::read_int(data, #at_l, #n, #big_endian) as #rt),
+                quote!(#link::write_uint(&mut buf, #at_l, #n, #big_endian, i64::from(*#name) as u64)),
+            )
+        }
+        FieldType::Bytes(_) => (quote!(#link::read_bytes(data, #at_l)), quote!(#link::write_bytes(&mut buf, #at_l, &#name[..]))),
+        FieldType::Tail { .. } => (quote!(data.get(#at_l..).unwrap_or(&[])), quote!(#link::write_bytes(&mut buf, #at_l, #name))),
+    }
+}
+
+fn direction_enum(cmds: &[&Command], enum_name: &Ident, max_data: usize) -> TokenStream {
+    let borrows = cmds.iter().any(|c| c.fields.iter().any(|f| matches!(f.ty, FieldType::Tail { .. })));
+    let lt = if borrows { quote!(<'a>) } else { quote!() };
+    let mut variants = Vec::new();
+    let mut decode_arms = Vec::new();
+    let mut encode_arms = Vec::new();
+    let mut name_arms = Vec::new();
+    for c in cmds {
+        let v = camel(&c.name);
+        let doc = format!(" `{}` ({:?}): {}", c.name, c.kind, c.description.split_whitespace().collect::<Vec<_>>().join(" "));
+        let mut decls = Vec::new();
+        let mut names = Vec::new();
+        let mut reads = Vec::new();
+        let mut writes = Vec::new();
+        if let Some(p) = &c.code_param {
+            let f = field_ident(&p.name);
+            decls.push(quote!(#f: u8));
+            let shift = p.mask.trailing_zeros();
+            let mask = crate::hex(p.mask.into(), 2);
+            reads.push(quote!(#f: (frame.code & #mask) >> #shift));
+            names.push(f);
+        }
+        for field in &c.fields {
+            let f = field_ident(&field.name);
+            let (ty, _) = field_type(field.ty, matches!(field.ty, FieldType::Signed(_)));
+            decls.push(quote!(#f: #ty));
+            let (read, write) = field_codec(field.ty, field.at, field.big_endian, &f);
+            reads.push(quote!(#f: #read));
+            writes.push(write);
+            names.push(f);
+        }
+        let variant_decl = if decls.is_empty() { quote!(#[doc = #doc] #v) } else { quote!(#[doc = #doc] #v { #(#decls),* }) };
+        variants.push(variant_decl);
+        // Decoding: the code (with its parameter bits), the length code, then the length.
+        let code = crate::hex(c.code.into(), 2);
+        let code_test = match &c.code_param {
+            None => quote!(frame.code == #code),
+            Some(p) => {
+                let mask = crate::hex(p.mask.into(), 2);
+                let shift = p.mask.trailing_zeros();
+                let allowed: Vec<u8> = c.codes().iter().map(|x| ((x & p.mask) >> shift) as u8).collect();
+                quote!(frame.code & !#mask == #code & !#mask && [#(#allowed),*].contains(&((frame.code & #mask) >> #shift)))
+            }
+        };
+        let lc = match c.length_code {
+            Some(x) => {
+                let x = crate::hex(x.into(), 2);
+                quote!(Some(#x))
+            }
+            None => quote!(None),
+        };
+        let (min, max) = (crate::dec(c.length.0.into()), crate::dec(c.length.1.into()));
+        let build = if decls.is_empty() { quote!(Self::#v) } else { quote!(Self::#v { #(#reads),* }) };
+        let length_check = if c.length_code.is_some() {
+            quote!()
+        } else {
+            quote! {
+                if !(#min..=#max).contains(&data.len()) {
+                    return Err(::coforge_link::fields::DecodeError::Length { min: #min, max: #max, got: data.len() });
+                }
+            }
+        };
+        decode_arms.push(quote! {
+            if #code_test && frame.length_code == #lc {
+                #length_check
+                return Ok(#build);
+            }
+        });
+        // Encoding: fields into a buffer, then the framing.
+        let code_expr = match &c.code_param {
+            None => quote!(#code),
+            Some(p) => {
+                let f = field_ident(&p.name);
+                let mask = crate::hex(p.mask.into(), 2);
+                let shift = p.mask.trailing_zeros();
+                quote!((#code & !#mask) | ((*#f << #shift) & #mask))
+            }
+        };
+        let fixed = crate::dec(c.fixed_size().into());
+        let len = match c.tail() {
+            Some(t) => {
+                let f = field_ident(&t.name);
+                let max_tail = crate::dec(match t.ty {
+                    FieldType::Tail { max } => max.into(),
+                    _ => 0,
+                });
+                quote! {{
+                    if #f.len() > #max_tail {
+                        return Err(::coforge_link::EncodeError::DataTooLong { max: #max_tail });
+                    }
+                    #fixed + #f.len()
+                }}
+            }
+            None => quote!(#fixed),
+        };
+        let pattern = if names.is_empty() { quote!(Self::#v) } else { quote!(Self::#v { #(#names),* }) };
+        encode_arms.push(quote! {
+            #pattern => {
+                let mut buf = [0_u8; MAX_DATA];
+                #(#writes;)*
+                let len = #len;
+                put_frame(#code_expr, #lc, buf.get(..len).unwrap_or(&[]), out)
+            }
+        });
+        let name = &c.name;
+        let name_pattern = if names.is_empty() { quote!(Self::#v) } else { quote!(Self::#v { .. }) };
+        name_arms.push(quote!(#name_pattern => #name));
+    }
+    let _ = max_data;
+    quote! {
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub enum #enum_name #lt { #(#variants),* }
+
+        impl #lt #enum_name #lt {
+            /// The command a decoded frame carries.
+            pub fn decode(frame: &::coforge_link::Frame #lt) -> Result<Self, ::coforge_link::fields::DecodeError> {
+                let data = frame.data;
+                #(#decode_arms)*
+                Err(::coforge_link::fields::DecodeError::UnknownCommand { code: frame.code })
+            }
+
+            /// Writes the whole frame into `out`; returns its length.
+            #[allow(unused_mut, unused_variables)]
+            pub fn encode(&self, out: &mut [u8]) -> Result<usize, ::coforge_link::EncodeError> {
+                match self { #(#encode_arms),* }
+            }
+
+            /// The command's name in the spec.
+            pub fn name(&self) -> &'static str {
+                match self { #(#name_arms),* }
+            }
+        }
+    }
+}
+
+pub fn serial_module(d: &Device, _options: &Options) -> TokenStream {
+    let Some(serial) = &d.serial else { return quote!() };
+    let max_data = serial.commands.iter().map(|c| c.length.1 as usize).max().unwrap_or(0).max(1);
+    let (framing, put, new_decoder) = framing_tokens(&serial.framing, max_data);
+    let dirs: Vec<TokenStream> = [(Direction::HostToDevice, "HostToDevice"), (Direction::DeviceToHost, "DeviceToHost")]
+        .into_iter()
+        .map(|(dir, name)| {
+            let cmds: Vec<&Command> = serial.commands.iter().filter(|c| c.direction == dir).collect();
+            if cmds.is_empty() {
+                return quote!();
+            }
+            direction_enum(&cmds, &Ident::new(name, Span::call_site()), max_data)
+        })
+        .collect();
+    let max = crate::dec(max_data as u64);
+    quote! {
+        /// The serial protocol: framing, decoder and typed commands, generated from the spec.
+        pub mod serial {
+            #framing
+
+            /// A fresh decoder for this protocol.
+            pub fn decoder() -> Decoder {
+                #new_decoder
+            }
+
+            /// The most data bytes any command carries.
+            pub const MAX_DATA: usize = #max;
+
+            #[allow(unused_variables)]
+            fn put_frame(code: u8, length_code: Option<u8>, data: &[u8], out: &mut [u8]) -> Result<usize, ::coforge_link::EncodeError> {
+                #put
+            }
+
+            #(#dirs)*
+        }
+    }
+}
