@@ -1,0 +1,3 @@
+coforge_macros::device!("../../../../spec/no-such-device.yaml");
+
+fn main() {}

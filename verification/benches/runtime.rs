@@ -1,0 +1,57 @@
+//! Runtime cost of generated code on the host: dictionary access through the generated
+//! dispatch, and deframing + decoding of each device's datasheet frames (per frame and per
+//! byte). Cortex-M instruction counts come with the board images.
+
+use coforge_link::{Deframer, Frame};
+use coforge_stack::od::{AccessContext, NmtState, NoAppObjects, ObjectDictionary, Side};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use std::hint::black_box;
+
+const OP: AccessContext = AccessContext { nmt: NmtState::Operational, can_enabled: true };
+
+fn dictionary(c: &mut Criterion) {
+    let mut od = co401gw1::Od::new(co401gw1::Mode::Mixed, 5, NoAppObjects);
+    let mut buf = [0_u8; 8];
+    c.bench_function("od/co401gw1/read_1018_1", |b| b.iter(|| od.read(black_box(0x1018), black_box(1), 0, &mut buf, Side::Bus)));
+    c.bench_function("od/co401gw1/write_1017", |b| b.iter(|| od.write(black_box(0x1017), 0, black_box(&[0xE8, 0x03]), Side::Bus, &OP)));
+    c.bench_function("od/co401gw1/read_6000_8", |b| b.iter(|| od.read(black_box(0x6000), black_box(8), 0, &mut buf, Side::Bus)));
+    c.bench_function("od/co401gw1/refused_write_1000", |b| b.iter(|| od.write(black_box(0x1000), 0, black_box(&[0; 4]), Side::Bus, &OP)));
+}
+
+/// Deframes and decodes one frame; returns whether it decoded.
+macro_rules! decode_once {
+    ($device:ident, $bytes:expr) => {{
+        let mut d = $device::serial::decoder();
+        let mut ok = false;
+        for (i, &b) in $bytes.iter().enumerate() {
+            if let Some(Ok(f)) = d.push(b, i as u32) {
+                let f: Frame<'_> = f;
+                ok = $device::serial::HostToDevice::decode(&f).is_ok() || $device::serial::DeviceToHost::decode(&f).is_ok();
+            }
+        }
+        ok
+    }};
+}
+
+fn codecs(c: &mut Criterion) {
+    let frames: [(&str, &[u8]); 3] = [
+        ("co401memory1/write_memory", &[0x44, 0x12, 0x50, 0x04, 0xAB]),
+        ("co401gw1/read_od_answer", &[0x21, 0x07, 0x18, 0x10, 0x04, 0x78, 0x56, 0x34, 0x12]),
+        ("canopenia/read_local", &[0x11, 0x04, 0x52, 0x00, 0x5F, 0x02, 0x96, 0x2F]),
+    ];
+    let mut group = c.benchmark_group("decode");
+    for (name, bytes) in frames {
+        group.throughput(Throughput::Bytes(bytes.len() as u64));
+        group.bench_function(name, |b| {
+            b.iter(|| match name.split('/').next() {
+                Some("co401memory1") => decode_once!(co401memory1, black_box(bytes)),
+                Some("co401gw1") => decode_once!(co401gw1, black_box(bytes)),
+                _ => decode_once!(canopenia, black_box(bytes)),
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, dictionary, codecs);
+criterion_main!(benches);
