@@ -113,3 +113,24 @@ fn cr3101_and_canopenia_dictionaries_sweep() {
     let n = sweep(&mut ia, canopenia::od::entries(canopenia::Mode::Default));
     assert!(n > 300);
 }
+
+#[test]
+fn co401gw1_persistent_block_saves_loads_and_restores() {
+    use co401gw1::{Mode, Od};
+    let mut a = Od::new(Mode::Mixed, 5, memory());
+    assert_eq!(a.write(0x100C, 0, &[0xF4, 0x01], Side::Bus, &PREOP), Ok(()));
+    assert_eq!(a.write(0x1800, 1, &[0x85, 0x03, 0, 0], Side::Bus, &PREOP), Ok(()), "TPDO1 COB-ID is persistent");
+    let mut block = vec![0_u8; Od::<Memory>::PERSISTENT_SIZE];
+    assert_eq!(a.save_persistent(&mut block), Some(block.len()));
+    assert_eq!(a.save_persistent(&mut [0; 3]), None, "a short buffer is refused");
+    let mut b = Od::new(Mode::Mixed, 5, memory());
+    assert!(!b.load_persistent(&block[..block.len() - 1]));
+    assert_eq!(b.guard_time, 0, "a short block changes nothing");
+    assert!(b.load_persistent(&block));
+    assert_eq!(b.guard_time, 500);
+    assert_eq!(read(&mut b, 0x1800, 1, Side::Bus), Ok(vec![0x85, 0x03, 0, 0]));
+    b.restore_defaults(7);
+    assert_eq!(b.guard_time, 0);
+    assert_eq!(read(&mut b, 0x1800, 1, Side::Bus), Ok(vec![0x87, 0x01, 0, 0]), "defaults with $NODEID for node 7");
+    const { assert!(Od::<Memory>::PERSISTENT_SIZE > 40) };
+}

@@ -119,6 +119,12 @@ struct Parts {
     inits: Vec<TokenStream>,
     read_arms: Vec<TokenStream>,
     write_arms: Vec<TokenStream>,
+    /// Persistent entries: (place, type, default), saved by 1010h and reset by 1011h.
+    persist: Vec<(TokenStream, TokenStream, TokenStream)>,
+}
+
+fn persistent(e: &Entry) -> bool {
+    e.storage == Storage::Persistent
 }
 
 fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
@@ -141,6 +147,9 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
         ObjectKind::Var | ObjectKind::Domain => {
             let e = kept[0];
             let (ty, init) = (rust_type(e, stack), initial(e, stack));
+            if persistent(e) {
+                parts.persist.push((quote!(self.#field), ty.clone(), init.clone()));
+            }
             parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
             parts.inits.push(quote!(#field: #init));
             parts.read_arms.push(quote!((#index, 0) => self.#field.read(info, offset, buf)));
@@ -153,6 +162,9 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
                 // Only sub 0 is stored: a plain field.
                 let e = kept[0];
                 let (ty, init) = (rust_type(e, stack), initial(e, stack));
+                if persistent(e) {
+                    parts.persist.push((quote!(self.#field), ty.clone(), init.clone()));
+                }
                 parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
                 parts.inits.push(quote!(#field: #init));
                 parts.read_arms.push(quote!((#index, 0) => self.#field.read(info, offset, buf)));
@@ -164,6 +176,13 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
             let item_inits: Vec<TokenStream> =
                 (1..=n).map(|s| items.iter().find(|e| usize::from(e.sub) == s).map_or(zero.clone(), |e| initial(e, stack))).collect();
             let sub0 = kept.iter().find(|e| e.sub == 0).map_or(quote!(0), |e| initial(e, stack));
+            if let Some(e) = kept.iter().find(|e| e.sub == 0 && persistent(e)) {
+                parts.persist.push((quote!(self.#field.sub0), quote!(u8), initial(e, stack)));
+            }
+            for e in items.iter().filter(|e| persistent(e)) {
+                let i = crate::dec(u64::from(e.sub) - 1);
+                parts.persist.push((quote!(self.#field.items[#i]), ty.clone(), initial(e, stack)));
+            }
             let count = crate::dec(n as u64);
             parts.fields.push(quote!(#[doc = #doc] pub #field: #stack::value::Array<#ty, #count>));
             parts.inits.push(quote!(#field: #stack::value::Array { sub0: #sub0, items: [#(#item_inits),*] }));
@@ -185,6 +204,9 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
                 let f = id(&e.ident);
                 let sub = crate::dec(e.sub.into());
                 let (ty, init) = (rust_type(e, stack), initial(e, stack));
+                if persistent(e) {
+                    parts.persist.push((quote!(self.#field.#f), ty.clone(), init.clone()));
+                }
                 let sdoc = format!(" Sub {}: {}", e.sub, e.name);
                 sub_fields.push(quote!(#[doc = #sdoc] pub #f: #ty));
                 sub_inits.push(quote!(#f: #init));
@@ -216,11 +238,14 @@ fn ranges(subs: &[u8]) -> Vec<(u8, u8)> {
 
 pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
     let stack = &options.stack;
-    let mut parts = Parts { structs: Vec::new(), fields: Vec::new(), inits: Vec::new(), read_arms: Vec::new(), write_arms: Vec::new() };
+    let mut parts = Parts { structs: Vec::new(), fields: Vec::new(), inits: Vec::new(), read_arms: Vec::new(), write_arms: Vec::new(), persist: Vec::new() };
     for slot in slots(d) {
         slot_parts(&slot, stack, &mut parts);
     }
-    let Parts { structs, fields, inits, read_arms, write_arms } = parts;
+    let Parts { structs, fields, inits, read_arms, write_arms, persist } = parts;
+    let places: Vec<&TokenStream> = persist.iter().map(|p| &p.0).collect();
+    let types: Vec<&TokenStream> = persist.iter().map(|p| &p.1).collect();
+    let defaults: Vec<&TokenStream> = persist.iter().map(|p| &p.2).collect();
     quote! {
         #(#structs)*
 
@@ -242,6 +267,46 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
 
             pub fn mode(&self) -> Mode {
                 self.mode
+            }
+
+            /// Bytes of the persistent block (every `storage: persistent` entry, index order).
+            pub const PERSISTENT_SIZE: usize = 0 #(+ <#types as #stack::value::Persist>::SIZE)*;
+
+            /// Writes the persistent block (1010h "save"); `None` if `out` is too small.
+            #[allow(unused_mut, unused_variables)]
+            pub fn save_persistent(&self, out: &mut [u8]) -> Option<usize> {
+                use #stack::value::Persist as _;
+                if out.len() < Self::PERSISTENT_SIZE {
+                    return None;
+                }
+                let mut at = 0;
+                #(
+                    #places.save(out.get_mut(at..).unwrap_or(&mut []));
+                    at += <#types as #stack::value::Persist>::SIZE;
+                )*
+                Some(at)
+            }
+
+            /// Loads a block written by [`Self::save_persistent`] (at boot); `false` and no change
+            /// if it is too short.
+            #[allow(unused_mut, unused_variables)]
+            pub fn load_persistent(&mut self, data: &[u8]) -> bool {
+                use #stack::value::Persist as _;
+                if data.len() < Self::PERSISTENT_SIZE {
+                    return false;
+                }
+                let mut at = 0;
+                #(
+                    #places.load(data.get(at..).unwrap_or(&[]));
+                    at += <#types as #stack::value::Persist>::SIZE;
+                )*
+                true
+            }
+
+            /// Sets every persistent entry back to its spec default (1011h "load").
+            #[allow(unused_variables)]
+            pub fn restore_defaults(&mut self, node_id: u8) {
+                #( #places = #defaults; )*
             }
         }
 

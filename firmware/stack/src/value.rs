@@ -158,3 +158,91 @@ pub struct Array<T, const N: usize> {
     pub sub0: u8,
     pub items: [T; N],
 }
+
+/// A field's fixed-size image in the 1010h/1011h store: what `save` writes, `load` reads.
+pub trait Persist {
+    /// Bytes of the image.
+    const SIZE: usize;
+    fn save(&self, out: &mut [u8]);
+    fn load(&mut self, data: &[u8]);
+}
+
+macro_rules! persist_number {
+    ($($t:ty),*) => {$(
+        impl Persist for $t {
+            const SIZE: usize = core::mem::size_of::<$t>();
+            fn save(&self, out: &mut [u8]) {
+                if let Some(dst) = out.get_mut(..Self::SIZE) {
+                    dst.copy_from_slice(&self.to_le_bytes());
+                }
+            }
+            fn load(&mut self, data: &[u8]) {
+                if let Some(bytes) = data.get(..Self::SIZE).and_then(|b| b.try_into().ok()) {
+                    *self = <$t>::from_le_bytes(bytes);
+                }
+            }
+        }
+    )*};
+}
+
+persist_number!(u8, u16, u32, u64, i8, i16, i32, i64, f32, f64);
+
+impl Persist for bool {
+    const SIZE: usize = 1;
+    fn save(&self, out: &mut [u8]) {
+        if let Some(b) = out.first_mut() {
+            *b = u8::from(*self);
+        }
+    }
+    fn load(&mut self, data: &[u8]) {
+        if let Some(&b) = data.first() {
+            *self = b != 0;
+        }
+    }
+}
+
+/// Strings: a 2-byte length, then `N` bytes.
+impl<const N: usize> Persist for Bytes<N> {
+    const SIZE: usize = 2 + N;
+    fn save(&self, out: &mut [u8]) {
+        let len = u16::try_from(self.len).unwrap_or(u16::MAX);
+        if let Some(l) = out.get_mut(..2) {
+            l.copy_from_slice(&len.to_le_bytes());
+        }
+        if let Some(b) = out.get_mut(2..2 + N) {
+            b.copy_from_slice(&self.bytes);
+        }
+    }
+    fn load(&mut self, data: &[u8]) {
+        let (Some(&[l0, l1]), Some(b)) = (data.get(..2).and_then(|l| <&[u8; 2]>::try_from(l).ok()), data.get(2..2 + N)) else { return };
+        let len = usize::from(u16::from_le_bytes([l0, l1]));
+        if len <= N {
+            self.bytes.copy_from_slice(b);
+            self.len = len;
+        }
+    }
+}
+
+#[cfg(test)]
+mod persist_tests {
+    use super::*;
+
+    #[test]
+    fn images_round_trip() {
+        let mut out = [0_u8; 16];
+        0x1234_u16.save(&mut out);
+        let mut v = 0_u16;
+        v.load(&out);
+        assert_eq!(v, 0x1234);
+        let s = Bytes::<8>::new("oil");
+        s.save(&mut out);
+        assert_eq!(out[..5], [3, 0, b'o', b'i', b'l']);
+        let mut t = Bytes::<8>::new("");
+        t.load(&out);
+        assert_eq!(t.as_bytes(), b"oil");
+        // A corrupt length leaves the value as it was.
+        out[0] = 200;
+        t.load(&out);
+        assert_eq!(t.as_bytes(), b"oil");
+    }
+}
