@@ -5,6 +5,7 @@
 #![forbid(unsafe_code)]
 
 mod setup;
+mod size;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -14,6 +15,7 @@ fn main() -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("dist") => dist(),
         Some("test") => test(),
+        Some("size") => setup::rust_targets().and_then(|()| size::report()),
         _ => {
             eprintln!(
                 "usage: cargo xtask <dist|test>\n  dist  check every spec and write EDS files and docs into target/dist/\n  test  install missing tools, then run the whole test suite"
@@ -117,27 +119,27 @@ fn test() -> Result {
     setup::rust_components()?;
     let python = setup::python_venv()?;
 
-    println!("xtask: [1/6] formatting and lints");
+    println!("xtask: [1/7] formatting and lints");
     run(cargo().args(["fmt", "--all", "--check"]))?;
     run(cargo().args(["clippy", "--quiet", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
 
-    println!("xtask: [2/6] Rust tests, and the no_std crates for the smallest target");
+    println!("xtask: [2/7] Rust tests, and the no_std crates for the smallest target");
     run(cargo().args(["test", "--workspace"]))?;
     for krate in NO_STD_CRATES {
         run(cargo().args(["build", "--quiet", "--release", "-p", krate, "--target", "thumbv6m-none-eabi"]))?;
     }
 
-    println!("xtask: [3/6] specs: check and canonical formatting");
+    println!("xtask: [3/7] specs: check and canonical formatting");
     run(cargo().args(["build", "--quiet", "-p", "coforge"]))?;
     let coforge = root().join("target/debug/coforge");
     let spec_args: Vec<PathBuf> = specs()?;
     run(Command::new(&coforge).arg("check").args(&spec_args))?;
     run(Command::new(&coforge).args(["fmt", "--check"]).args(&spec_args))?;
 
-    println!("xtask: [4/6] main outputs build (cargo xtask dist)");
+    println!("xtask: [4/7] main outputs build (cargo xtask dist)");
     dist()?;
 
-    println!("xtask: [5/6] interoperability tests with python-canopen");
+    println!("xtask: [5/7] interoperability tests with python-canopen");
     let status = Command::new(&python)
         .args(["-m", "pytest", "-q", "tests/python"])
         .env("COFORGE_BIN", &coforge)
@@ -150,8 +152,11 @@ fn test() -> Result {
         Some(5) => return Err("pytest collected no tests in tests/python".into()),
         _ => return Err(format!("pytest failed ({status})")),
     }
-    println!("xtask: [6/6] short fuzz runs of every streaming decoder (cargo fuzz)");
+    println!("xtask: [6/7] short fuzz runs of every streaming decoder (cargo fuzz)");
     fuzz()?;
+
+    println!("xtask: [7/7] size of the generated code on a Cortex-M0");
+    size::report()?;
 
     println!("xtask: all tests passed");
     Ok(())

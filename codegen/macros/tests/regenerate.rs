@@ -34,7 +34,8 @@ fn editing_the_spec_rebuilds_the_generated_code() {
     std::fs::write(dir.join("Cargo.toml"), manifest).expect("manifest");
     // The main lock file pins the same dependency versions, so the offline build resolves.
     std::fs::copy(root.join("Cargo.lock"), dir.join("Cargo.lock")).expect("lock file");
-    std::fs::write(dir.join("src/main.rs"), "coforge_macros::device!(\"spec.yaml\");\n\nfn main() {\n    println!(\"{:#06x}\", VENDOR_ID);\n}\n").expect("main");
+    std::fs::write(dir.join("src/main.rs"), "coforge_macros::device!(\"spec.yaml\");\n\nfn main() {\n    println!(\"{:#06x}\", VENDOR_ID);\n}\n")
+        .expect("main");
     let spec = std::fs::read_to_string(root.join("codegen/spec/tests/fixtures/valid/minimal.yaml")).expect("fixture");
     std::fs::write(dir.join("spec.yaml"), &spec).expect("spec");
     assert_eq!(run(&dir), "0x1234");
