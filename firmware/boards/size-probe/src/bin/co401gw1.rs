@@ -21,10 +21,10 @@ fn main() -> ! {
         let _ = black_box(od.read(index, sub, 0, &mut buf, Side::Bus));
         let _ = black_box(od.write(index, sub, black_box(&buf[..4]), Side::Host, &ctx));
         let _ = black_box(od.save_persistent(&mut block));
-        if let Some(Ok(frame)) = decoder.push(black_box(0x11), black_box(0)) {
-            if let Ok(cmd) = serial::HostToDevice::decode(&frame) {
-                let _ = black_box(cmd.encode(&mut buf));
-            }
+        if let Some(Ok(frame)) = decoder.push(black_box(0x11), black_box(0))
+            && let Ok(cmd) = serial::HostToDevice::decode(&frame)
+        {
+            let _ = black_box(cmd.encode(&mut buf));
         }
     }
 }
