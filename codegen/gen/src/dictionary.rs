@@ -144,32 +144,13 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
     let field = id(&o.ident);
     let doc = format!(" {:04X}h {}", slot.index, o.name);
     match o.kind {
-        ObjectKind::Var | ObjectKind::Domain => {
-            let e = kept[0];
-            let (ty, init) = (rust_type(e, stack), initial(e, stack));
-            if persistent(e) {
-                parts.persist.push((quote!(self.#field), ty.clone(), init.clone()));
-            }
-            parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
-            parts.inits.push(quote!(#field: #init));
-            parts.read_arms.push(quote!((#index, 0) => self.#field.read(info, offset, buf)));
-            parts.write_arms.push(quote!((#index, 0) => self.#field.write(info, data)));
-        }
+        ObjectKind::Var | ObjectKind::Domain => plain_field(kept[0], &field, &doc, &index, stack, parts),
         ObjectKind::Array => {
             let items: Vec<&Entry> = kept.iter().copied().filter(|e| e.sub > 0).collect();
             let n = items.iter().map(|e| usize::from(e.sub)).max().unwrap_or(0);
             let Some(first) = items.first() else {
-                // Only sub 0 is stored: a plain field.
-                let e = kept[0];
-                let (ty, init) = (rust_type(e, stack), initial(e, stack));
-                if persistent(e) {
-                    parts.persist.push((quote!(self.#field), ty.clone(), init.clone()));
-                }
-                parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
-                parts.inits.push(quote!(#field: #init));
-                parts.read_arms.push(quote!((#index, 0) => self.#field.read(info, offset, buf)));
-                parts.write_arms.push(quote!((#index, 0) => self.#field.write(info, data)));
-                return;
+                // Only sub 0 is stored (the elements are app-backed): a plain field.
+                return plain_field(kept[0], &field, &doc, &index, stack, parts);
             };
             let ty = rust_type(first, stack);
             let zero = initial(&Entry { default: None, ..(*first).clone() }, stack);
@@ -222,6 +203,18 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
             parts.inits.push(quote!(#field: #name { #(#sub_inits),* }));
         }
     }
+}
+
+/// A single stored entry (a VAR, or sub 0 alone) as one field.
+fn plain_field(e: &Entry, field: &Ident, doc: &str, index: &TokenStream, stack: &TokenStream, parts: &mut Parts) {
+    let (ty, init) = (rust_type(e, stack), initial(e, stack));
+    if persistent(e) {
+        parts.persist.push((quote!(self.#field), ty.clone(), init.clone()));
+    }
+    parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
+    parts.inits.push(quote!(#field: #init));
+    parts.read_arms.push(quote!((#index, 0) => self.#field.read(info, offset, buf)));
+    parts.write_arms.push(quote!((#index, 0) => self.#field.write(info, data)));
 }
 
 /// Consecutive runs of sub-indices.

@@ -325,25 +325,31 @@ impl AppObjects for NoAppObjects {
     }
 }
 
+/// An entry at 2000h.0 with no limits, for unit tests.
+#[cfg(test)]
+pub(crate) const fn test_entry(data_type: DataType, access: Access, host_access: HostAccess, size: u16) -> EntryInfo {
+    EntryInfo {
+        index: 0x2000,
+        sub: 0,
+        last_sub: 0,
+        data_type,
+        access,
+        host_access,
+        host_write_before_can_enabled: false,
+        pdo_mappable: false,
+        storage: Storage::Ram,
+        writable_in: NmtStates::ALL,
+        size,
+        limits: None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     const fn info(data_type: DataType, access: Access, host_access: HostAccess, size: u16) -> EntryInfo {
-        EntryInfo {
-            index: 0x2000,
-            sub: 0,
-            last_sub: 0,
-            data_type,
-            access,
-            host_access,
-            host_write_before_can_enabled: false,
-            pdo_mappable: false,
-            storage: Storage::Ram,
-            writable_in: NmtStates::ALL,
-            size,
-            limits: None,
-        }
+        test_entry(data_type, access, host_access, size)
     }
 
     const OP: AccessContext = AccessContext { nmt: NmtState::Operational, can_enabled: true };

@@ -96,23 +96,10 @@ impl<const N: usize> OdValue for Bytes<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::od::{Access, DataType, HostAccess, NmtStates, Storage};
+    use crate::od::{Access, DataType, HostAccess};
 
     fn info(data_type: DataType, size: u16) -> EntryInfo {
-        EntryInfo {
-            index: 0x2000,
-            sub: 0,
-            last_sub: 0,
-            data_type,
-            access: Access::Rw,
-            host_access: HostAccess::None,
-            host_write_before_can_enabled: false,
-            pdo_mappable: false,
-            storage: Storage::Ram,
-            writable_in: NmtStates::ALL,
-            size,
-            limits: None,
-        }
+        crate::od::test_entry(data_type, Access::Rw, HostAccess::None, size)
     }
 
     #[test]
