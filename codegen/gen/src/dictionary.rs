@@ -3,10 +3,11 @@
 //! `ObjectDictionary` implementation whose dispatch is a generated `match`.
 
 use crate::Options;
+use crate::naming::{camel, ident as id};
 use coforge_spec::model::{Device, Entry, Object, Value};
 use coforge_spec::types::{DataType, ObjectKind, Storage};
-use proc_macro2::{Ident, Span, TokenStream};
-use quote::{format_ident, quote};
+use proc_macro2::{Ident, TokenStream};
+use quote::quote;
 use std::collections::BTreeMap;
 
 /// One index, merged over every mode it exists in.
@@ -26,22 +27,6 @@ fn slots(d: &Device) -> Vec<Slot<'_>> {
         }
     }
     map.into_values().collect()
-}
-
-fn id(name: &str) -> Ident {
-    let safe = if name.starts_with(|c: char| c.is_ascii_digit()) || name.is_empty() { format!("_{name}") } else { name.to_string() };
-    match safe.as_str() {
-        "type" | "match" | "mod" | "struct" | "enum" | "fn" | "use" | "ref" | "move" | "self" | "super" | "crate" | "loop" | "while" | "for" | "if"
-        | "else" | "in" | "let" | "mut" | "pub" | "return" | "static" | "const" | "trait" | "impl" | "where" | "async" | "await" | "dyn" | "box" | "yield"
-        | "macro" | "try" | "final" | "override" | "virtual" | "abstract" | "become" | "do" | "priv" | "typeof" | "unsized" | "as" | "break" | "continue"
-        | "extern" | "false" | "true" | "unsafe" | "gen" => format_ident!("r#{}", safe),
-        _ => Ident::new(&safe, Span::call_site()),
-    }
-}
-
-fn camel(ident: &str) -> Ident {
-    let s: String = ident.split('_').filter(|p| !p.is_empty()).map(|p| p[..1].to_ascii_uppercase() + &p[1..]).collect();
-    id(&s)
 }
 
 /// The Rust type of an entry's field.

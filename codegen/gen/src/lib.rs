@@ -16,6 +16,7 @@
 mod dictionary;
 mod entries;
 mod modes;
+mod naming;
 mod pdos;
 mod serial;
 

@@ -9,16 +9,12 @@ pub struct Modes {
     pub variants: Vec<(Ident, Option<String>)>,
 }
 
-fn camel(name: &str) -> String {
-    name.split('_').filter(|p| !p.is_empty()).map(|p| p[..1].to_ascii_uppercase() + &p[1..]).collect()
-}
-
 impl Modes {
     pub fn of(d: &Device) -> Modes {
         let variants = if d.modes.is_empty() {
             vec![(Ident::new("Default", Span::call_site()), None)]
         } else {
-            d.modes.iter().map(|m| (Ident::new(&camel(&m.name), Span::call_site()), Some(m.name.clone()))).collect()
+            d.modes.iter().map(|m| (crate::naming::camel(&m.name), Some(m.name.clone()))).collect()
         };
         Modes { variants }
     }
@@ -46,15 +42,5 @@ impl Modes {
     pub fn select(&self, per_mode: &[TokenStream]) -> TokenStream {
         let arms = self.variants.iter().zip(per_mode).map(|((v, _), e)| quote!(Mode::#v => #e));
         quote!(match mode { #(#arms),* })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn camel_case_of_mode_names() {
-        assert_eq!(super::camel("digital_alt"), "DigitalAlt");
-        assert_eq!(super::camel("pdo_read"), "PdoRead");
-        assert_eq!(super::camel("mixed"), "Mixed");
     }
 }

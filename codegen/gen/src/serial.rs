@@ -2,37 +2,25 @@
 //! protocol's commands with typed fields, `decode(&Frame)` and `encode(&mut [u8])`.
 
 use crate::Options;
+use crate::naming::{camel, ident as field_ident};
 use coforge_spec::model::{Command, Device, Direction, FieldType, Framing, LengthCounts};
 use proc_macro2::{Ident, Span, TokenStream};
-use quote::{format_ident, quote};
+use quote::quote;
 
-fn camel(name: &str) -> Ident {
-    let s: String = name.split('_').filter(|p| !p.is_empty()).map(|p| p[..1].to_ascii_uppercase() + &p[1..]).collect();
-    Ident::new(&s, Span::call_site())
-}
-
-fn field_ident(name: &str) -> Ident {
-    match name {
-        "type" | "ref" | "mod" | "match" | "fn" | "struct" | "enum" | "use" | "in" | "as" | "const" | "static" | "loop" | "move" | "box" | "self" | "super"
-        | "crate" => format_ident!("r#{}", name),
-        _ => Ident::new(name, Span::call_site()),
-    }
-}
-
-/// The Rust type of a field and whether it borrows the frame.
-fn field_type(ty: FieldType, signed: bool) -> (TokenStream, bool) {
-    match (ty, signed) {
-        (FieldType::Unsigned(1), _) => (quote!(u8), false),
-        (FieldType::Unsigned(2), _) => (quote!(u16), false),
-        (FieldType::Unsigned(_), _) => (quote!(u32), false),
-        (FieldType::Signed(1), _) => (quote!(i8), false),
-        (FieldType::Signed(2), _) => (quote!(i16), false),
-        (FieldType::Signed(_), _) => (quote!(i32), false),
-        (FieldType::Bytes(n), _) => {
+/// The Rust type of a field (tails borrow the frame).
+fn field_type(ty: FieldType) -> TokenStream {
+    match ty {
+        FieldType::Unsigned(1) => quote!(u8),
+        FieldType::Unsigned(2) => quote!(u16),
+        FieldType::Unsigned(_) => quote!(u32),
+        FieldType::Signed(1) => quote!(i8),
+        FieldType::Signed(2) => quote!(i16),
+        FieldType::Signed(_) => quote!(i32),
+        FieldType::Bytes(n) => {
             let n = crate::dec(n.into());
-            (quote!([u8; #n]), false)
+            quote!([u8; #n])
         }
-        (FieldType::Tail { .. }, _) => (quote!(&'a [u8]), true),
+        FieldType::Tail { .. } => quote!(&'a [u8]),
     }
 }
 
@@ -118,12 +106,12 @@ fn field_codec(ty: FieldType, at: u32, big_endian: bool, name: &Ident) -> (Token
     match ty {
         FieldType::Unsigned(n) => {
             let n = crate::dec(n.into());
-            let (rt, _) = field_type(ty, false);
+            let rt = field_type(ty);
             (quote!(#link::read_uint(data, #at_l, #n, #big_endian) as #rt), quote!(#link::write_uint(&mut buf, #at_l, #n, #big_endian, u64::from(*#name))))
         }
         FieldType::Signed(n) => {
             let n = crate::dec(n.into());
-            let (rt, _) = field_type(ty, true);
+            let rt = field_type(ty);
             (
                 quote!(#link::read_int(data, #at_l, #n, #big_endian) as #rt),
                 quote!(#link::write_uint(&mut buf, #at_l, #n, #big_endian, i64::from(*#name) as u64)),
@@ -134,7 +122,7 @@ fn field_codec(ty: FieldType, at: u32, big_endian: bool, name: &Ident) -> (Token
     }
 }
 
-fn direction_enum(cmds: &[&Command], enum_name: &Ident, max_data: usize) -> TokenStream {
+fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
     let borrows = cmds.iter().any(|c| c.fields.iter().any(|f| matches!(f.ty, FieldType::Tail { .. })));
     let lt = if borrows { quote!(<'a>) } else { quote!() };
     let mut variants = Vec::new();
@@ -158,7 +146,7 @@ fn direction_enum(cmds: &[&Command], enum_name: &Ident, max_data: usize) -> Toke
         }
         for field in &c.fields {
             let f = field_ident(&field.name);
-            let (ty, _) = field_type(field.ty, matches!(field.ty, FieldType::Signed(_)));
+            let ty = field_type(field.ty);
             decls.push(quote!(#f: #ty));
             let (read, write) = field_codec(field.ty, field.at, field.big_endian, &f);
             reads.push(quote!(#f: #read));
@@ -242,7 +230,6 @@ fn direction_enum(cmds: &[&Command], enum_name: &Ident, max_data: usize) -> Toke
         let name_pattern = if names.is_empty() { quote!(Self::#v) } else { quote!(Self::#v { .. }) };
         name_arms.push(quote!(#name_pattern => #name));
     }
-    let _ = max_data;
     quote! {
         #[derive(Debug, Clone, Copy, PartialEq, Eq)]
         pub enum #enum_name #lt { #(#variants),* }
@@ -280,7 +267,7 @@ pub fn serial_module(d: &Device, _options: &Options) -> TokenStream {
             if cmds.is_empty() {
                 return quote!();
             }
-            direction_enum(&cmds, &Ident::new(name, Span::call_site()), max_data)
+            direction_enum(&cmds, &Ident::new(name, Span::call_site()))
         })
         .collect();
     let max = crate::dec(max_data as u64);
