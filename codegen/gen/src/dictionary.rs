@@ -104,8 +104,29 @@ struct Parts {
     inits: Vec<TokenStream>,
     read_arms: Vec<TokenStream>,
     write_arms: Vec<TokenStream>,
-    /// Persistent entries: (place, type, default), saved by 1010h and reset by 1011h.
-    persist: Vec<(TokenStream, TokenStream, TokenStream)>,
+    /// Persistent entries, saved by 1010h.
+    persist: Vec<Place>,
+    /// Every stored entry (RAM and persistent): what an NMT reset sets back to its default.
+    resets: Vec<Place>,
+}
+
+/// One stored value: its index, where it lives in `Od`, its type and its default.
+#[derive(Clone)]
+struct Place {
+    index: TokenStream,
+    place: TokenStream,
+    ty: TokenStream,
+    default: TokenStream,
+}
+
+impl Parts {
+    fn place(&mut self, e: &Entry, index: &TokenStream, place: TokenStream, ty: TokenStream, default: TokenStream) {
+        let p = Place { index: index.clone(), place, ty, default };
+        if persistent(e) {
+            self.persist.push(p.clone());
+        }
+        self.resets.push(p);
+    }
 }
 
 fn persistent(e: &Entry) -> bool {
@@ -142,12 +163,12 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
             let item_inits: Vec<TokenStream> =
                 (1..=n).map(|s| items.iter().find(|e| usize::from(e.sub) == s).map_or(zero.clone(), |e| initial(e, stack))).collect();
             let sub0 = kept.iter().find(|e| e.sub == 0).map_or(quote!(0), |e| initial(e, stack));
-            if let Some(e) = kept.iter().find(|e| e.sub == 0 && persistent(e)) {
-                parts.persist.push((quote!(self.#field.sub0), quote!(u8), initial(e, stack)));
+            if let Some(e) = kept.iter().find(|e| e.sub == 0) {
+                parts.place(e, &index, quote!(self.#field.sub0), quote!(u8), initial(e, stack));
             }
-            for e in items.iter().filter(|e| persistent(e)) {
+            for e in &items {
                 let i = crate::dec(u64::from(e.sub) - 1);
-                parts.persist.push((quote!(self.#field.items[#i]), ty.clone(), initial(e, stack)));
+                parts.place(e, &index, quote!(self.#field.items[#i]), ty.clone(), initial(e, stack));
             }
             let count = crate::dec(n as u64);
             parts.fields.push(quote!(#[doc = #doc] pub #field: #stack::value::Array<#ty, #count>));
@@ -170,9 +191,7 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
                 let f = id(&e.ident);
                 let sub = crate::dec(e.sub.into());
                 let (ty, init) = (rust_type(e, stack), initial(e, stack));
-                if persistent(e) {
-                    parts.persist.push((quote!(self.#field.#f), ty.clone(), init.clone()));
-                }
+                parts.place(e, &index, quote!(self.#field.#f), ty.clone(), init.clone());
                 let sdoc = format!(" Sub {}: {}", e.sub, e.name);
                 sub_fields.push(quote!(#[doc = #sdoc] pub #f: #ty));
                 sub_inits.push(quote!(#f: #init));
@@ -193,9 +212,7 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
 /// A single stored entry (a VAR, or sub 0 alone) as one field.
 fn plain_field(e: &Entry, field: &Ident, doc: &str, index: &TokenStream, stack: &TokenStream, parts: &mut Parts) {
     let (ty, init) = (rust_type(e, stack), initial(e, stack));
-    if persistent(e) {
-        parts.persist.push((quote!(self.#field), ty.clone(), init.clone()));
-    }
+    parts.place(e, index, quote!(self.#field), ty.clone(), init.clone());
     parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
     parts.inits.push(quote!(#field: #init));
     parts.read_arms.push(quote!((#index, 0) => self.#field.read(info, offset, buf)));
@@ -216,14 +233,23 @@ fn ranges(subs: &[u8]) -> Vec<(u8, u8)> {
 
 pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
     let stack = &options.stack;
-    let mut parts = Parts { structs: Vec::new(), fields: Vec::new(), inits: Vec::new(), read_arms: Vec::new(), write_arms: Vec::new(), persist: Vec::new() };
+    let mut parts = Parts {
+        structs: Vec::new(),
+        fields: Vec::new(),
+        inits: Vec::new(),
+        read_arms: Vec::new(),
+        write_arms: Vec::new(),
+        persist: Vec::new(),
+        resets: Vec::new(),
+    };
     for slot in slots(d) {
         slot_parts(&slot, stack, &mut parts);
     }
-    let Parts { structs, fields, inits, read_arms, write_arms, persist } = parts;
-    let places: Vec<&TokenStream> = persist.iter().map(|p| &p.0).collect();
-    let types: Vec<&TokenStream> = persist.iter().map(|p| &p.1).collect();
-    let defaults: Vec<&TokenStream> = persist.iter().map(|p| &p.2).collect();
+    let Parts { structs, fields, inits, read_arms, write_arms, persist, resets } = parts;
+    let (p_index, places): (Vec<&TokenStream>, Vec<&TokenStream>) = persist.iter().map(|p| (&p.index, &p.place)).unzip();
+    let types: Vec<&TokenStream> = persist.iter().map(|p| &p.ty).collect();
+    let (r_index, r_places): (Vec<&TokenStream>, Vec<&TokenStream>) = resets.iter().map(|p| (&p.index, &p.place)).unzip();
+    let r_defaults: Vec<&TokenStream> = resets.iter().map(|p| &p.default).collect();
     quote! {
         #(#structs)*
 
@@ -246,45 +272,51 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
             pub fn mode(&self) -> Mode {
                 self.mode
             }
+        }
 
-            /// Bytes of the persistent block (every `storage: persistent` entry, index order).
-            pub const PERSISTENT_SIZE: usize = 0 #(+ <#types as #stack::value::Persist>::SIZE)*;
+        impl<A: #stack::od::AppObjects> #stack::od::Dictionary for Od<A> {
+            const PERSISTENT_SIZE: usize = 0 #(+ <#types as #stack::value::Persist>::SIZE)*;
 
-            /// Writes the persistent block (1010h "save"); `None` if `out` is too small.
             #[allow(unused_mut, unused_variables)]
-            pub fn save_persistent(&self, out: &mut [u8]) -> Option<usize> {
+            fn save_area(&self, area: #stack::od::Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
                 use #stack::value::Persist as _;
-                if out.len() < Self::PERSISTENT_SIZE {
-                    return None;
-                }
-                let mut at = 0;
+                let (mut at, mut ok) = (0, true);
                 #(
-                    #places.save(out.get_mut(at..).unwrap_or(&mut []));
+                    if area.contains(#p_index) {
+                        let mut image = [0_u8; <#types as #stack::value::Persist>::SIZE];
+                        #places.save(&mut image);
+                        ok &= sink(at, &image);
+                    }
                     at += <#types as #stack::value::Persist>::SIZE;
                 )*
-                Some(at)
+                ok
             }
 
-            /// Loads a block written by [`Self::save_persistent`] (at boot); `false` and no change
-            /// if it is too short.
             #[allow(unused_mut, unused_variables)]
-            pub fn load_persistent(&mut self, data: &[u8]) -> bool {
+            fn load_area(&mut self, area: #stack::od::Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
                 use #stack::value::Persist as _;
-                if data.len() < Self::PERSISTENT_SIZE {
-                    return false;
-                }
-                let mut at = 0;
+                let (mut at, mut ok) = (0, true);
                 #(
-                    #places.load(data.get(at..).unwrap_or(&[]));
+                    if area.contains(#p_index) {
+                        let mut image = [0_u8; <#types as #stack::value::Persist>::SIZE];
+                        if source(at, &mut image) {
+                            #places.load(&image);
+                        } else {
+                            ok = false;
+                        }
+                    }
                     at += <#types as #stack::value::Persist>::SIZE;
                 )*
-                true
+                ok
             }
 
-            /// Sets every persistent entry back to its spec default (1011h "load").
             #[allow(unused_variables)]
-            pub fn restore_defaults(&mut self, node_id: u8) {
-                #( #places = #defaults; )*
+            fn reset_area(&mut self, area: #stack::od::Area, node_id: u8) {
+                #( if area.contains(#r_index) { #r_places = #r_defaults; } )*
+            }
+
+            fn emergencies(&self) -> &'static [#stack::emcy::EmcyDefault] {
+                emcy::emergencies(self.mode)
             }
         }
 

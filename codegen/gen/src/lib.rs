@@ -14,6 +14,7 @@
 #![forbid(unsafe_code)]
 
 mod dictionary;
+mod emcy;
 mod entries;
 mod modes;
 mod naming;
@@ -61,6 +62,8 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
     let pdo = pdos::pdo_module(device, &modes, options);
     let dictionary = dictionary::dictionary(device, options);
     let serial = serial::serial_module(device, options);
+    let emcy = emcy::emcy_module(device, &modes, options);
+    let stack = &options.stack;
     quote! {
         /// Device name from the spec.
         pub const NAME: &str = #name;
@@ -73,7 +76,11 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
         #od
         #pdo
         #dictionary
+        #emcy
         #serial
+
+        /// The device's CANopen node: its dictionary, parameter store `S` and app objects `A`.
+        pub type Node<A, S> = #stack::node::Node<Od<A>, S, { od::MAX_WRITE_SIZE }, { pdo::SLOTS }>;
     }
 }
 

@@ -57,10 +57,22 @@ pub fn pdo_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             pub fn #f(mode: Mode) -> &'static [#stack::pdo::PdoDefault] { #select }
         });
     }
+    // Runtime PDO slots per direction: the most communication objects of one direction in a mode.
+    let slots = modes
+        .variants
+        .iter()
+        .flat_map(|(_, mode)| {
+            [PdoDir::Rx, PdoDir::Tx].map(|dir| d.pdo.pdos.iter().filter(|p| p.dir == dir && in_mode(&p.modes, mode.as_deref())).count())
+        })
+        .max()
+        .unwrap_or(0);
+    let slots = crate::dec(slots as u64);
     quote! {
         /// Default PDO configuration, generated from the spec.
         pub mod pdo {
             use super::Mode;
+            /// PDOs per direction the node keeps state for.
+            pub const SLOTS: usize = #slots;
             #(#statics)*
             #(#selects)*
         }

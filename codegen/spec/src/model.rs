@@ -3,7 +3,7 @@
 
 use crate::diag::Span;
 use crate::expr::Expr;
-use crate::types::{Access, DataType, HostAccess, NmtState, ObjectKind, Storage, Sub0, WriteWhen};
+use crate::types::{Access, DataType, EmcyEvent, HostAccess, NmtState, ObjectKind, Storage, Sub0, WriteWhen};
 use std::collections::{BTreeMap, BTreeSet};
 
 #[derive(Debug, Clone)]
@@ -360,6 +360,8 @@ pub struct Emergency {
     pub outputs: OutputEffect,
     pub reset: String,
     pub enabled_by: Option<u16>,
+    /// The stack condition that sends this emergency.
+    pub event: Option<EmcyEvent>,
     pub example: Option<Vec<u8>>,
     pub modes: ModeSet,
     pub span: Span,

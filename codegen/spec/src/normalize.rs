@@ -9,7 +9,7 @@ use crate::expr::{Expr, Vars};
 use crate::model::*;
 use crate::raw::{self, Num, S, Scalar};
 use crate::template::interpolate;
-use crate::types::{Access, DataType, HostAccess, NmtState, ObjectKind, Storage, Sub0, WriteWhen, snake_case};
+use crate::types::{Access, DataType, EmcyEvent, HostAccess, NmtState, ObjectKind, Storage, Sub0, WriteWhen, snake_case};
 use std::collections::{BTreeMap, BTreeSet};
 
 pub const FORMAT_VERSION: u32 = 1;
@@ -941,8 +941,13 @@ fn emergency(cx: &mut Cx<'_>, e: &S<raw::Emergency>) -> Option<Emergency> {
         )?,
         None => OutputEffect::Unchanged,
     };
+    let event = match &v.event {
+        Some(n) => Some(cx.keyword(n, "stack event", EmcyEvent::parse, &EmcyEvent::ALL.map(EmcyEvent::name).join(", "))?),
+        None => None,
+    };
     Some(Emergency {
         name: v.name.value.clone(),
+        event,
         code,
         error_register,
         manufacturer,

@@ -406,6 +406,8 @@ pub struct Emergency {
     #[serde(default)]
     pub enabled_by: Option<Num>,
     #[serde(default)]
+    pub event: Option<S<String>>,
+    #[serde(default)]
     pub example: Option<S<Scalar>>,
     #[serde(default)]
     pub modes: Option<S<Vec<S<String>>>>,

@@ -1,14 +1,28 @@
 //! The CANopen runtime that every generated coforge device implements and runs on.
 //!
-//! This version holds the object dictionary interface ([`od`]): the trait the `device!`
-//! macro implements, entry metadata, the access checks of both sides (CANopen bus and
-//! serial host) and the CiA 301 SDO abort codes. The protocol engines (NMT, SDO, PDO, EMCY,
-//! heartbeat) build on it.
+//! - [`od`]: the object dictionary interface the `device!` macro implements, entry metadata,
+//!   the access checks of both sides (bus and serial host) and the CiA 301 SDO abort codes;
+//! - [`frame`]: the CAN frame exchanged with the board (an `embedded-can` frame);
+//! - [`sdo`]: the SDO server (expedited, segmented and block transfer);
+//! - the other protocol engines (NMT, PDO, EMCY, SYNC, heartbeat, guarding, store/restore)
+//!   and the [`node::Node`] that owns them.
+//!
+//! Everything is `no_std`, heap-free and poll-driven: the board feeds received frames and
+//! the current time in microseconds, and takes the frames to send.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
 #![cfg_attr(test, allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
+pub mod emcy;
+pub mod frame;
+pub mod guarding;
+pub mod heartbeat;
+pub mod leds;
+pub mod nmt;
+pub mod node;
 pub mod od;
 pub mod pdo;
+pub mod sdo;
+pub mod store;
 pub mod value;

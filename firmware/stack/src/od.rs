@@ -189,6 +189,13 @@ impl EntryInfo {
 
     /// Whether `side` may write `data` to this entry: access, state, length and value.
     pub fn check_write(&self, side: Side, ctx: &AccessContext, data: &[u8]) -> Result<(), SdoAbort> {
+        self.check_write_access(side, ctx)?;
+        self.check_length(data.len())?;
+        self.check_value(data)
+    }
+
+    /// Whether `side` may write this entry now, whatever the value: access and state.
+    pub fn check_write_access(&self, side: Side, ctx: &AccessContext) -> Result<(), SdoAbort> {
         match side {
             Side::Device => {}
             Side::Bus => {
@@ -211,8 +218,7 @@ impl EntryInfo {
                 }
             }
         }
-        self.check_length(data.len())?;
-        self.check_value(data)
+        Ok(())
     }
 
     /// Whether this description covers `sub`.
@@ -302,6 +308,60 @@ pub trait ObjectDictionary {
     /// Writes `data` (the whole value, little-endian) after the checks for `side`. A refused
     /// write leaves the stored value unchanged.
     fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side, ctx: &AccessContext) -> Result<(), SdoAbort>;
+}
+
+/// A range of object indices: what 1010h/1011h sub-indices and NMT resets act on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Area {
+    pub first: u16,
+    pub last: u16,
+}
+
+impl Area {
+    pub const ALL: Area = Area { first: 0x0000, last: 0xFFFF };
+    /// 1000h..1FFFh: what "reset communication" and 1010h sub 2 act on.
+    pub const COMMUNICATION: Area = Area { first: 0x1000, last: 0x1FFF };
+    /// 6000h..9FFFh (1010h sub 3).
+    pub const APPLICATION: Area = Area { first: 0x6000, last: 0x9FFF };
+    /// 2000h..5FFFh (1010h sub 4).
+    pub const MANUFACTURER: Area = Area { first: 0x2000, last: 0x5FFF };
+
+    pub const fn contains(self, index: u16) -> bool {
+        self.first <= index && index <= self.last
+    }
+
+    /// The area a 1010h/1011h sub-index names (CiA 301 7.5.2.13).
+    pub const fn of_store_sub(sub: u8) -> Option<Area> {
+        match sub {
+            1 => Some(Area::ALL),
+            2 => Some(Area::COMMUNICATION),
+            3 => Some(Area::APPLICATION),
+            4 => Some(Area::MANUFACTURER),
+            _ => None,
+        }
+    }
+}
+
+/// What a node needs from a generated dictionary besides reads and writes: the spec
+/// defaults, the persistent block and the emergencies.
+pub trait Dictionary: ObjectDictionary {
+    /// Bytes of the persistent block (every `storage: persistent` entry, index order).
+    const PERSISTENT_SIZE: usize;
+
+    /// Hands the image of every persistent entry of `area` to `sink` with its offset in the
+    /// block, so the block is written without a buffer of its size; `false` if `sink` failed.
+    fn save_area(&self, area: Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool;
+
+    /// Loads every persistent entry of `area` from `source` (offset, buffer to fill); an entry
+    /// whose image `source` cannot give keeps its value, and the result is `false`.
+    fn load_area(&mut self, area: Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool;
+
+    /// Sets every stored entry (RAM and persistent) of `area` back to its spec default,
+    /// `$NODEID` resolved for `node_id`. App-backed entries are the device's business.
+    fn reset_area(&mut self, area: Area, node_id: u8);
+
+    /// The spec's emergencies in the dictionary's mode.
+    fn emergencies(&self) -> &'static [crate::emcy::EmcyDefault];
 }
 
 /// Objects whose data the device keeps outside the dictionary (EEPROM banks, a memory card):

@@ -410,3 +410,77 @@ mod tests {
         assert_eq!(DataType::Integer8.int_range(), Some((-128, 127)));
     }
 }
+
+/// A condition the CANopen stack detects by itself, tied to the spec emergency it sends
+/// (`event:` in the spec). Events without a spec emergency use the CiA 301 code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum EmcyEvent {
+    /// No guarding remote frame within the node life time (100C x 100D).
+    LifeGuarding,
+    /// No guarding remote frame within the guard time (frenzel+berg 2103).
+    GuardingWarning,
+    /// A consumed heartbeat (1016) was not received in time.
+    HeartbeatTimeout,
+    /// The CAN controller reached its error-warning limit.
+    CanWarning,
+    /// The CAN controller went error-passive.
+    CanPassive,
+    /// Received frames were lost (controller overrun).
+    CanOverrun,
+    /// The CAN controller went bus-off.
+    BusOff,
+    /// The CAN controller returned from bus-off.
+    BusOffRecovered,
+    /// A received PDO was shorter than its mapping.
+    RpdoLength,
+}
+
+impl EmcyEvent {
+    pub const ALL: [EmcyEvent; 9] = [
+        EmcyEvent::LifeGuarding,
+        EmcyEvent::GuardingWarning,
+        EmcyEvent::HeartbeatTimeout,
+        EmcyEvent::CanWarning,
+        EmcyEvent::CanPassive,
+        EmcyEvent::CanOverrun,
+        EmcyEvent::BusOff,
+        EmcyEvent::BusOffRecovered,
+        EmcyEvent::RpdoLength,
+    ];
+
+    /// The spec keyword.
+    pub const fn name(self) -> &'static str {
+        match self {
+            EmcyEvent::LifeGuarding => "life_guarding",
+            EmcyEvent::GuardingWarning => "guarding_warning",
+            EmcyEvent::HeartbeatTimeout => "heartbeat_timeout",
+            EmcyEvent::CanWarning => "can_warning",
+            EmcyEvent::CanPassive => "can_passive",
+            EmcyEvent::CanOverrun => "can_overrun",
+            EmcyEvent::BusOff => "bus_off",
+            EmcyEvent::BusOffRecovered => "bus_off_recovered",
+            EmcyEvent::RpdoLength => "rpdo_length",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<EmcyEvent> {
+        EmcyEvent::ALL.into_iter().find(|e| e.name() == s)
+    }
+
+    /// The CiA 301 error code (table 21) when the spec lists no emergency for the event.
+    pub const fn default_code(self) -> u16 {
+        match self {
+            EmcyEvent::LifeGuarding | EmcyEvent::GuardingWarning | EmcyEvent::HeartbeatTimeout => 0x8130,
+            EmcyEvent::CanWarning => 0x8100,
+            EmcyEvent::CanOverrun => 0x8110,
+            EmcyEvent::CanPassive => 0x8120,
+            EmcyEvent::BusOff | EmcyEvent::BusOffRecovered => 0x8140,
+            EmcyEvent::RpdoLength => 0x8210,
+        }
+    }
+
+    /// Whether the event counts as a communication error for 1029h sub 1.
+    pub const fn is_communication_error(self) -> bool {
+        matches!(self, EmcyEvent::LifeGuarding | EmcyEvent::HeartbeatTimeout | EmcyEvent::BusOff)
+    }
+}

@@ -49,6 +49,13 @@ pub fn duplicate(d: &Device, diags: &mut Diagnostics) {
             if !modes_overlap(&a.modes, &b.modes) {
                 continue;
             }
+            if a.event.is_some() && a.event == b.event {
+                let event = a.event.map_or("", |e| e.name());
+                diags.push(
+                    Diagnostic::error("emcy-duplicate", b.span, format!("emergencies `{}` and `{}` are both sent for stack event `{event}`", a.name, b.name))
+                        .note_at(a.span, "the other emergency"),
+                );
+            }
             if a.name == b.name {
                 diags.push(
                     Diagnostic::error("emcy-duplicate", b.span, format!("emergency `{}` is defined twice", b.name)).note_at(a.span, "first defined here"),

@@ -51,7 +51,7 @@ pub const RULES: &[Rule] = &[
     Rule { id: "serial-crc", summary: "the CRC parameters do not produce the stated check value", check: serial::crc },
     Rule { id: "emcy-example", summary: "an emergency's example frame disagrees with its code, register and bytes", check: emcy::example },
     Rule { id: "emcy-register", summary: "an emergency sets error-register bits without the generic error bit 0", check: emcy::register },
-    Rule { id: "emcy-duplicate", summary: "two emergencies share a name or the same frame", check: emcy::duplicate },
+    Rule { id: "emcy-duplicate", summary: "two emergencies share a name, a stack event or the same frame", check: emcy::duplicate },
     Rule { id: "emcy-reference", summary: "an emergency is enabled by an object that does not exist", check: emcy::reference },
     Rule { id: "redundant-pair", summary: "a redundant pair's objects are missing or differ in structure", check: od::redundant_pair },
     Rule { id: "hardware-codes", summary: "a selector code does not fit its pins, repeats, or reads a missing object", check: hardware::codes },

@@ -1,0 +1,84 @@
+//! `emcy::emergencies(mode)`: the spec's emergencies as the stack's `EmcyDefault`, and one
+//! constant per emergency so device code raises them by name.
+
+use crate::Options;
+use crate::modes::Modes;
+use coforge_spec::model::{Device, Emergency, NmtEffect, in_mode};
+use proc_macro2::TokenStream;
+use quote::{format_ident, quote};
+
+fn emergency(e: &Emergency, stack: &TokenStream) -> TokenStream {
+    let name = &e.name;
+    let code = crate::hex(e.code.into(), 4);
+    let register = crate::hex(e.error_register.into(), 2);
+    // Bytes the spec marks as varying (`xx`) start as zero; the device fills them in.
+    let manufacturer = e.manufacturer.map(|b| crate::hex(b.unwrap_or(0).into(), 2));
+    let reaction = match e.nmt {
+        NmtEffect::None => quote!(None),
+        NmtEffect::ErrorBehavior => quote!(ErrorBehaviour),
+        NmtEffect::PreOperational => quote!(PreOperational),
+        NmtEffect::Stopped => quote!(Stopped),
+    };
+    let event = match e.event {
+        Some(ev) => {
+            let v = format_ident!("{}", format!("{ev:?}"));
+            quote!(Some(#stack::emcy::EmcyEvent::#v))
+        }
+        None => quote!(None),
+    };
+    let enabled_by = match e.enabled_by {
+        Some(i) => {
+            let i = crate::hex(i.into(), 4);
+            quote!(Some(#i))
+        }
+        None => quote!(None),
+    };
+    quote! {
+        #stack::emcy::EmcyDefault {
+            name: #name,
+            code: #code,
+            register: #register,
+            manufacturer: [#(#manufacturer),*],
+            reaction: #stack::emcy::Reaction::#reaction,
+            event: #event,
+            enabled_by: #enabled_by,
+        }
+    }
+}
+
+pub fn emcy_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
+    let stack = &options.stack;
+    // One constant per distinct name; a name defined per mode keeps its first definition.
+    let mut seen = std::collections::BTreeSet::new();
+    let consts: Vec<TokenStream> = d
+        .emergencies
+        .iter()
+        .filter(|e| seen.insert(e.name.clone()))
+        .map(|e| {
+            let c = format_ident!("{}", e.name.to_uppercase());
+            let doc = format!(" {:04X}h: {}", e.code, e.description);
+            let value = emergency(e, stack);
+            quote!(#[doc = #doc] pub const #c: #stack::emcy::EmcyDefault = #value;)
+        })
+        .collect();
+    let mut statics = Vec::new();
+    let mut per_mode = Vec::new();
+    for (variant, mode) in &modes.variants {
+        let list: Vec<TokenStream> = d.emergencies.iter().filter(|e| in_mode(&e.modes, mode.as_deref())).map(|e| emergency(e, stack)).collect();
+        let count = crate::dec(list.len() as u64);
+        let name = format_ident!("EMCY_{}", variant.to_string().to_uppercase());
+        statics.push(quote!(static #name: [#stack::emcy::EmcyDefault; #count] = [#(#list),*];));
+        per_mode.push(quote!(&#name));
+    }
+    let select = modes.select(&per_mode);
+    quote! {
+        /// The spec's emergencies.
+        pub mod emcy {
+            use super::Mode;
+            #(#consts)*
+            #(#statics)*
+            /// The emergencies of `mode`.
+            pub fn emergencies(mode: Mode) -> &'static [#stack::emcy::EmcyDefault] { #select }
+        }
+    }
+}

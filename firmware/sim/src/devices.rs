@@ -1,0 +1,148 @@
+//! The four coforge devices as simulator nodes, chosen by name at run time.
+
+use crate::app::RamApp;
+use crate::storage::MemStorage;
+use coforge_stack::emcy::EmcyDefault;
+use coforge_stack::frame::CanFrame;
+use coforge_stack::node::{BusState, Node, NodeEvent};
+use coforge_stack::od::{Dictionary, ReadLen, SdoAbort, Side};
+use coforge_stack::store::{BlockStore, ParamStore};
+use std::path::PathBuf;
+
+/// A running device, whatever its dictionary type.
+pub trait SimNode: Send {
+    fn start(&mut self, now_us: u64);
+    fn on_frame(&mut self, frame: &CanFrame, now_us: u64);
+    fn poll(&mut self, now_us: u64) -> Option<CanFrame>;
+    fn state(&self) -> coforge_stack::nmt::NmtState;
+    fn node_id(&self) -> u8;
+    /// A read or write as the device itself (no access rules; lengths and limits apply).
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort>;
+    /// The spec emergency called `name` (fault injection); `false` if there is none.
+    fn raise(&mut self, name: &str) -> bool;
+    fn clear(&mut self, name: &str) -> bool;
+    fn on_bus_state(&mut self, bus: BusState, now_us: u64);
+    fn take_event(&mut self) -> Option<NodeEvent>;
+    fn trigger_tpdo(&mut self, number: u16);
+    /// Static RAM of the node (its `size_of`).
+    fn ram_bytes(&self) -> usize;
+}
+
+impl<D, S, const N: usize, const P: usize> SimNode for Node<D, S, N, P>
+where
+    D: Dictionary + Send,
+    S: ParamStore + Send,
+{
+    fn start(&mut self, now_us: u64) {
+        Node::start(self, now_us);
+    }
+    fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
+        Node::on_frame(self, frame, now_us);
+    }
+    fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
+        Node::poll(self, now_us)
+    }
+    fn state(&self) -> coforge_stack::nmt::NmtState {
+        Node::state(self)
+    }
+    fn node_id(&self) -> u8 {
+        Node::node_id(self)
+    }
+    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        Node::read(self, index, sub, 0, buf, Side::Device)
+    }
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
+        Node::write(self, index, sub, data, side)
+    }
+    fn raise(&mut self, name: &str) -> bool {
+        let found: Option<EmcyDefault> = self.od().emergencies().iter().find(|e| e.name == name).copied();
+        found.map(|e| Node::raise(self, &e)).is_some()
+    }
+    fn clear(&mut self, name: &str) -> bool {
+        let found: Option<EmcyDefault> = self.od().emergencies().iter().find(|e| e.name == name).copied();
+        found.map(|e| Node::clear(self, &e)).is_some()
+    }
+    fn on_bus_state(&mut self, bus: BusState, now_us: u64) {
+        Node::on_bus_state(self, bus, now_us);
+    }
+    fn take_event(&mut self) -> Option<NodeEvent> {
+        Node::take_event(self)
+    }
+    fn trigger_tpdo(&mut self, number: u16) {
+        Node::trigger_tpdo(self, number);
+    }
+    fn ram_bytes(&self) -> usize {
+        core::mem::size_of::<Self>()
+    }
+}
+
+/// Where a simulated device keeps its parameters.
+#[derive(Debug, Clone, Default)]
+pub enum StoreAt {
+    /// In memory: survives NMT resets, not a restart of the simulator.
+    #[default]
+    Memory,
+    /// In a file.
+    File(PathBuf),
+}
+
+/// A device the simulator can run.
+#[derive(Debug, Clone, Copy)]
+pub struct DeviceKind {
+    pub name: &'static str,
+    /// Mode names from the spec (the first is the default).
+    pub modes: fn() -> Vec<&'static str>,
+    build: fn(Option<&str>, u8, MemStorage) -> Result<Box<dyn SimNode>, String>,
+    persistent_size: usize,
+}
+
+macro_rules! device_kind {
+    ($krate:ident) => {
+        DeviceKind {
+            name: stringify!($krate),
+            modes: || $krate::Mode::ALL.iter().map(|m| m.name()).collect(),
+            build: |mode, node_id, storage| {
+                let mode = match mode {
+                    None => $krate::Mode::ALL[0],
+                    Some(name) => $krate::Mode::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
+                        let known: Vec<&str> = $krate::Mode::ALL.iter().map(|m| m.name()).collect();
+                        format!("{} has no mode `{name}`; its modes are: {}", stringify!($krate), known.join(", "))
+                    })?,
+                };
+                let od = $krate::Od::new(mode, node_id, RamApp::default());
+                let node: $krate::Node<RamApp, BlockStore<MemStorage>> = Node::new(od, BlockStore::new(storage, 0), $krate::node_config(node_id));
+                Ok(Box::new(node))
+            },
+            persistent_size: <$krate::Od<RamApp> as Dictionary>::PERSISTENT_SIZE,
+        }
+    };
+}
+
+/// Every device, by crate name.
+pub const DEVICES: [DeviceKind; 4] = [device_kind!(co401memory1), device_kind!(co401gw1), device_kind!(cr3101), device_kind!(canopenia)];
+
+/// Bytes of parameter storage a device needs: the block header plus its persistent entries.
+const HEADER: usize = 12;
+
+impl DeviceKind {
+    pub fn find(name: &str) -> Result<DeviceKind, String> {
+        DEVICES.into_iter().find(|d| d.name == name).ok_or_else(|| {
+            let known: Vec<&str> = DEVICES.iter().map(|d| d.name).collect();
+            format!("unknown device `{name}`; known devices: {}", known.join(", "))
+        })
+    }
+
+    /// A node of this device, not started yet.
+    pub fn create(&self, mode: Option<&str>, node_id: u8, store: &StoreAt) -> Result<Box<dyn SimNode>, String> {
+        if !(1..=127).contains(&node_id) {
+            return Err(format!("node-ID {node_id} is outside 1..=127"));
+        }
+        let capacity = HEADER + self.persistent_size;
+        let storage = match store {
+            StoreAt::Memory => MemStorage::new(capacity),
+            StoreAt::File(path) => MemStorage::with_file(capacity, path.clone()).map_err(|e| format!("{}: {e}", path.display()))?,
+        };
+        (self.build)(mode, node_id, storage)
+    }
+}

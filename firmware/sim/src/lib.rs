@@ -1,0 +1,18 @@
+//! Runs coforge CANopen devices on a PC: a virtual CAN bus that in-process nodes and SLCAN
+//! tools (python-can's `slcan` interface over `socket://`, `nc`) share.
+//!
+//! - [`slcan`]: the Lawicel ASCII protocol, an encoder and a streaming decoder that never panics;
+//! - [`hub`]: the bus, a TCP SLCAN listener plus in-process [`hub::Port`]s;
+//! - [`devices`]: the four coforge devices as [`devices::SimNode`]s, by name;
+//! - [`vbus`]: a deterministic in-process bus on a virtual clock, for tests;
+//! - [`storage`], [`app`]: parameter storage (memory or file) and app-backed objects.
+#![forbid(unsafe_code)]
+#![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
+#![cfg_attr(test, allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
+pub mod app;
+pub mod devices;
+pub mod hub;
+pub mod slcan;
+pub mod storage;
+pub mod vbus;

@@ -1,0 +1,85 @@
+//! Parameter storage for simulated devices: an EEPROM image in memory, optionally mirrored
+//! to a file so stored parameters survive restarting the simulator.
+
+use embedded_storage::{ReadStorage, Storage};
+use std::path::PathBuf;
+
+/// Why a storage access failed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum StorageError {
+    OutOfBounds,
+    File(String),
+}
+
+/// A byte-addressable store of `capacity` bytes, erased to 0xFF like an EEPROM.
+#[derive(Debug, Clone)]
+pub struct MemStorage {
+    bytes: Vec<u8>,
+    file: Option<PathBuf>,
+    /// Writes so far, for tests that count them.
+    pub writes: u64,
+}
+
+impl MemStorage {
+    pub fn new(capacity: usize) -> Self {
+        MemStorage { bytes: vec![0xFF; capacity], file: None, writes: 0 }
+    }
+
+    /// Backed by `path`: loaded from it if it exists, written through on every write.
+    pub fn with_file(capacity: usize, path: PathBuf) -> std::io::Result<Self> {
+        let mut bytes = match std::fs::read(&path) {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+            Err(e) => return Err(e),
+        };
+        bytes.resize(capacity, 0xFF);
+        Ok(MemStorage { bytes, file: Some(path), writes: 0 })
+    }
+
+    pub fn bytes(&self) -> &[u8] {
+        &self.bytes
+    }
+
+    /// Direct access, for tests that corrupt the image.
+    pub fn bytes_mut(&mut self) -> &mut [u8] {
+        &mut self.bytes
+    }
+
+    fn range(&self, offset: u32, len: usize) -> Result<std::ops::Range<usize>, StorageError> {
+        let start = usize::try_from(offset).map_err(|_| StorageError::OutOfBounds)?;
+        let end = start.checked_add(len).ok_or(StorageError::OutOfBounds)?;
+        if end > self.bytes.len() { Err(StorageError::OutOfBounds) } else { Ok(start..end) }
+    }
+}
+
+impl embedded_storage::nor_flash::NorFlashError for StorageError {
+    fn kind(&self) -> embedded_storage::nor_flash::NorFlashErrorKind {
+        embedded_storage::nor_flash::NorFlashErrorKind::Other
+    }
+}
+
+impl ReadStorage for MemStorage {
+    type Error = StorageError;
+
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), StorageError> {
+        let r = self.range(offset, bytes.len())?;
+        bytes.copy_from_slice(self.bytes.get(r).ok_or(StorageError::OutOfBounds)?);
+        Ok(())
+    }
+
+    fn capacity(&self) -> usize {
+        self.bytes.len()
+    }
+}
+
+impl Storage for MemStorage {
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), StorageError> {
+        let r = self.range(offset, bytes.len())?;
+        self.bytes.get_mut(r).ok_or(StorageError::OutOfBounds)?.copy_from_slice(bytes);
+        self.writes += 1;
+        if let Some(path) = &self.file {
+            std::fs::write(path, &self.bytes).map_err(|e| StorageError::File(e.to_string()))?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,179 @@
+//! The CANopen stack of generated devices on the virtual bus, driven frame by frame the way a
+//! master would: NMT, SDO, PDOs, heartbeat, guarding, EMCY, store/restore.
+
+use coforge_sim::devices::{DeviceKind, SimNode, StoreAt};
+use coforge_sim::vbus::VirtualBus;
+use coforge_stack::frame::CanFrame;
+use coforge_stack::nmt::NmtState;
+
+const ID: u8 = 5;
+
+fn node(device: &str) -> Box<dyn SimNode> {
+    DeviceKind::find(device).unwrap().create(None, ID, &StoreAt::Memory).unwrap()
+}
+
+fn bus(device: &str) -> VirtualBus {
+    let mut bus = VirtualBus::new(vec![node(device)]);
+    let boot = bus.drain();
+    assert_eq!(boot, vec![CanFrame::data(0x705, &[0]).unwrap()], "boot-up message");
+    bus
+}
+
+fn frame(id: u16, data: &[u8]) -> CanFrame {
+    CanFrame::data(id, data).unwrap()
+}
+
+fn nmt(bus: &mut VirtualBus, cs: u8) {
+    bus.send(frame(0x000, &[cs, ID]));
+}
+
+/// One SDO request and the server's answer.
+fn sdo(bus: &mut VirtualBus, req: [u8; 8]) -> [u8; 8] {
+    bus.send(frame(0x600 + u16::from(ID), &req));
+    let answers: Vec<CanFrame> = bus.drain().into_iter().filter(|f| f.id == 0x580 + u16::from(ID)).collect();
+    assert_eq!(answers.len(), 1, "one SDO answer: {answers:?}");
+    answers[0].data
+}
+
+fn upload(bus: &mut VirtualBus, index: u16, sub: u8) -> Result<Vec<u8>, u32> {
+    let [lo, hi] = index.to_le_bytes();
+    let r = sdo(bus, [0x40, lo, hi, sub, 0, 0, 0, 0]);
+    match r[0] {
+        0x80 => Err(u32::from_le_bytes(r[4..8].try_into().unwrap())),
+        c if c & 0xE2 == 0x42 => {
+            let n = if c & 1 == 1 { 4 - usize::from(c >> 2 & 3) } else { 4 };
+            Ok(r[4..4 + n].to_vec())
+        }
+        c if c & 0xE3 == 0x41 => {
+            let size = u32::from_le_bytes(r[4..8].try_into().unwrap()) as usize;
+            let mut out = Vec::new();
+            let mut toggle = 0;
+            while out.len() < size {
+                let s = sdo(bus, [0x60 | toggle, 0, 0, 0, 0, 0, 0, 0]);
+                assert_eq!(s[0] & 0xE0, 0x00, "upload segment");
+                assert_eq!(s[0] & 0x10, toggle, "toggle");
+                let n = 7 - usize::from(s[0] >> 1 & 7);
+                out.extend_from_slice(&s[1..1 + n]);
+                toggle ^= 0x10;
+                if s[0] & 1 == 1 {
+                    break;
+                }
+            }
+            assert_eq!(out.len(), size);
+            Ok(out)
+        }
+        c => panic!("unexpected upload answer {c:#04X}"),
+    }
+}
+
+fn download(bus: &mut VirtualBus, index: u16, sub: u8, data: &[u8]) -> Result<(), u32> {
+    assert!(data.len() <= 4, "expedited only");
+    let [lo, hi] = index.to_le_bytes();
+    let mut req = [0x23 | (4 - data.len() as u8) << 2, lo, hi, sub, 0, 0, 0, 0];
+    req[4..4 + data.len()].copy_from_slice(data);
+    let r = sdo(bus, req);
+    match r[0] {
+        0x60 => Ok(()),
+        0x80 => Err(u32::from_le_bytes(r[4..8].try_into().unwrap())),
+        c => panic!("unexpected download answer {c:#04X}"),
+    }
+}
+
+fn u32_of(v: &[u8]) -> u32 {
+    v.iter().rev().fold(0, |acc, &b| acc << 8 | u32::from(b))
+}
+
+#[test]
+fn nmt_states_and_what_they_allow() {
+    let mut bus = bus("co401gw1");
+    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational);
+    nmt(&mut bus, 0x01);
+    assert_eq!(bus.nodes[0].state(), NmtState::Operational);
+    nmt(&mut bus, 0x02);
+    assert_eq!(bus.nodes[0].state(), NmtState::Stopped);
+    bus.send(frame(0x605, &[0x40, 0x00, 0x10, 0, 0, 0, 0, 0]));
+    assert!(bus.drain().is_empty(), "no SDO in Stopped");
+    nmt(&mut bus, 0x80);
+    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational);
+    bus.send(frame(0x000, &[0x01, ID + 1]));
+    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational, "addressed to another node");
+    bus.send(frame(0x000, &[0x01, 0]));
+    assert_eq!(bus.nodes[0].state(), NmtState::Operational, "broadcast");
+    nmt(&mut bus, 0x82);
+    assert_eq!(bus.drain(), vec![frame(0x705, &[0])], "reset communication boots again");
+    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational);
+}
+
+#[test]
+fn sdo_reads_writes_and_aborts() {
+    let mut bus = bus("co401gw1");
+    assert_eq!(u32_of(&upload(&mut bus, 0x1000, 0).unwrap()), 0x000F_0191);
+    assert_eq!(upload(&mut bus, 0x1008, 0).unwrap(), b"CO401GW1".to_vec(), "segmented upload");
+    assert_eq!(download(&mut bus, 0x1000, 0, &[0, 0, 0, 0]), Err(0x0601_0002), "read-only");
+    assert_eq!(upload(&mut bus, 0x1234, 0), Err(0x0602_0000), "no object");
+    assert_eq!(upload(&mut bus, 0x1018, 9), Err(0x0609_0011), "no sub-index");
+    assert_eq!(download(&mut bus, 0x1017, 0, &[1]), Err(0x0607_0013), "too short");
+    assert_eq!(download(&mut bus, 0x2180, 0, &60000_u16.to_le_bytes()), Err(0x0609_0031), "above 50000");
+    download(&mut bus, 0x1017, 0, &100_u16.to_le_bytes()).unwrap();
+    assert_eq!(upload(&mut bus, 0x1017, 0).unwrap(), 100_u16.to_le_bytes().to_vec());
+}
+
+#[test]
+fn heartbeat_every_period() {
+    let mut bus = bus("co401gw1");
+    download(&mut bus, 0x1017, 0, &100_u16.to_le_bytes()).unwrap();
+    bus.drain();
+    bus.advance_ms(1000);
+    let beats: Vec<(u64, CanFrame)> = bus.log.iter().copied().filter(|(_, f)| f.id == 0x705 && f.data[0] == 0x7F).collect();
+    assert_eq!(beats.len(), 10, "{beats:?}");
+    let gaps: Vec<u64> = beats.windows(2).map(|w| w[1].0 - w[0].0).collect();
+    assert!(gaps.iter().all(|&g| g == 100_000), "{gaps:?}");
+}
+
+#[test]
+fn node_guarding_and_life_guarding_emcy() {
+    let mut bus = bus("co401gw1");
+    download(&mut bus, 0x100C, 0, &100_u16.to_le_bytes()).unwrap();
+    download(&mut bus, 0x100D, 0, &[3]).unwrap();
+    nmt(&mut bus, 0x01);
+    bus.drain();
+    let rtr = CanFrame::remote(0x705, 1).unwrap();
+    bus.send(rtr);
+    assert_eq!(bus.drain(), vec![frame(0x705, &[0x05])]);
+    bus.send(rtr);
+    assert_eq!(bus.drain(), vec![frame(0x705, &[0x85])], "toggle bit");
+    bus.advance_ms(301);
+    let emcy: Vec<CanFrame> = bus.drain().into_iter().filter(|f| f.id == 0x85).collect();
+    assert_eq!(emcy, vec![frame(0x85, &[0x30, 0x81, 0x01, 0, 0, 0, 0, 0x30])], "life guarding error from the spec");
+    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational, "1029 sub 1 = 0: operational -> pre-operational");
+    assert_eq!(upload(&mut bus, 0x1001, 0).unwrap(), vec![0x01]);
+    bus.send(rtr);
+    let after: Vec<CanFrame> = bus.drain();
+    assert!(after.contains(&frame(0x85, &[0, 0, 0, 0, 0, 0, 0, 0])), "error reset: {after:?}");
+    assert_eq!(upload(&mut bus, 0x1001, 0).unwrap(), vec![0x00]);
+}
+
+#[test]
+fn tpdo_remapping_and_transmission_types() {
+    let mut bus = bus("co401gw1");
+    // Remap TPDO1 (1800h/1A00h) to 6000h.1 + 6000h.2, synchronous every 2nd SYNC.
+    let cob = u32_of(&upload(&mut bus, 0x1800, 1).unwrap());
+    assert_eq!(cob & 0x7FF, 0x185);
+    assert_eq!(download(&mut bus, 0x1A00, 0, &[0]), Err(0x0800_0022), "mapping while the PDO is valid");
+    download(&mut bus, 0x1800, 1, &(cob | 0x8000_0000).to_le_bytes()).unwrap();
+    download(&mut bus, 0x1A00, 0, &[0]).unwrap();
+    download(&mut bus, 0x1A00, 1, &0x6000_0108_u32.to_le_bytes()).unwrap();
+    download(&mut bus, 0x1A00, 2, &0x6000_0208_u32.to_le_bytes()).unwrap();
+    assert_eq!(download(&mut bus, 0x1A00, 3, &0x1000_0020_u32.to_le_bytes()), Err(0x0604_0041), "1000h is not mappable");
+    download(&mut bus, 0x1A00, 0, &[2]).unwrap();
+    download(&mut bus, 0x1800, 2, &[2]).unwrap();
+    download(&mut bus, 0x1800, 1, &cob.to_le_bytes()).unwrap();
+    nmt(&mut bus, 0x01);
+    bus.drain();
+    bus.nodes[0].write(0x6000, 1, &[0xAB], coforge_stack::od::Side::Device).unwrap();
+    let sync = frame(0x080, &[]);
+    bus.send(sync);
+    assert!(bus.drain().is_empty(), "first SYNC of two");
+    bus.send(sync);
+    assert_eq!(bus.drain(), vec![frame(0x185, &[0xAB, 0x00])]);
+}

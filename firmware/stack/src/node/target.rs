@@ -1,0 +1,112 @@
+//! Writes with their side effects, and the SDO server's view of the node.
+
+use super::{Core, read_u32};
+use crate::od::{Dictionary, ReadLen, SdoAbort, Side, Storage};
+use crate::pdo::Dir;
+use crate::sdo::SdoTarget;
+use crate::store::ParamStore;
+
+impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+    /// A write from any side: the communication-object rules first, then the dictionary's
+    /// own checks, then whatever the new value changes.
+    pub(super) fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
+        let ctx = self.ctx();
+        let entry = *self.od.entry(index, sub)?;
+        if matches!(index, 0x1010 | 0x1011) && sub >= 1 {
+            entry.check_write(side, &ctx, data)?;
+            return self.store_command(index, sub, data);
+        }
+        self.check_communication(index, sub, data, side)?;
+        self.od.write(index, sub, data, side, &ctx)?;
+        self.after_write(index, sub);
+        if self.cfg.auto_save && entry.storage == Storage::Persistent && side != Side::Device {
+            self.store.save(&self.od, crate::od::Area::ALL).map_err(|_| SdoAbort::Hardware)?;
+        }
+        Ok(())
+    }
+
+    /// 1010h "save" / 1011h "load" (CiA 301 7.5.2.13/14): the signature, then the store.
+    fn store_command(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        let signature: &[u8] = if index == 0x1010 { b"save" } else { b"load" };
+        if data != signature {
+            return Err(SdoAbort::DataTransfer);
+        }
+        // Manufacturer-specific sub-indices beyond 4 act on everything.
+        let area = crate::od::Area::of_store_sub(sub).unwrap_or(crate::od::Area::ALL);
+        let result = if index == 0x1010 {
+            self.store.save(&self.od, area)
+        } else if area == crate::od::Area::ALL {
+            // Restored defaults take effect at the next reset (CiA 301).
+            self.store.erase()
+        } else {
+            // One area of a single stored block: store that area's defaults.
+            self.od.reset_area(area, self.node_id);
+            let saved = self.store.save(&self.od, area);
+            self.reload_services(self.now_us);
+            saved
+        };
+        result.map_err(|_| SdoAbort::Hardware)
+    }
+
+    /// Re-reads what a written object configures, and marks event-driven TPDOs that map it.
+    pub(super) fn after_write(&mut self, index: u16, sub: u8) {
+        let now = self.now_us;
+        match index {
+            0x1005 | 0x100C..=0x100E | 0x1014..=0x1017 => self.reload_services(now),
+            _ => {}
+        }
+        match Dir::of_index(index) {
+            Some((Dir::Rx, _, offset)) => {
+                if let Some(r) = self.rpdos.iter_mut().find(|r| r.offset == offset) {
+                    *r = crate::pdo::Rpdo::load(&mut self.od, offset);
+                }
+            }
+            Some((Dir::Tx, _, offset)) => {
+                if let Some(i) = self.tpdos.iter().position(|t| t.offset == offset) {
+                    let t = crate::pdo::Tpdo::load(&mut self.od, offset, now);
+                    if let Some(slot) = self.tpdos.get_mut(i) {
+                        *slot = t;
+                    }
+                }
+            }
+            None => {
+                for t in &mut self.tpdos {
+                    if t.comm.valid() && t.mapping.contains(index, sub) {
+                        t.trigger();
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl<D: Dictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, P> {
+    fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        self.od.read(index, sub, offset, buf, Side::Bus)
+    }
+
+    fn check_download(&mut self, index: u16, sub: u8, size: Option<usize>) -> Result<(), SdoAbort> {
+        let ctx = self.ctx();
+        let entry = self.od.entry(index, sub)?;
+        entry.check_write_access(Side::Bus, &ctx)?;
+        match size {
+            Some(n) if n > usize::from(entry.size) => Err(SdoAbort::LengthTooHigh),
+            _ => Ok(()),
+        }
+    }
+
+    fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        Core::write(self, index, sub, data, Side::Bus)
+    }
+}
+
+/// The value a write would leave in a 4-byte entry.
+pub(super) fn le_u32(data: &[u8]) -> u32 {
+    data.iter().take(4).rev().fold(0, |acc, &b| acc << 8 | u32::from(b))
+}
+
+impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+    pub(super) fn current(&mut self, index: u16, sub: u8) -> u32 {
+        read_u32(&mut self.od, index, sub).unwrap_or(0)
+    }
+}

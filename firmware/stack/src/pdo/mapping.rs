@@ -1,0 +1,138 @@
+//! PDO mapping entries (16xxh/1Axxh): decoding, the CiA 301 mappability checks, and packing
+//! mapped values into a frame.
+
+use super::Dir;
+use crate::od::{DataType, ObjectDictionary, SdoAbort, Side};
+
+/// Most entries a PDO maps (one per byte of a CAN frame).
+pub const MAX_MAPPED: usize = 8;
+
+/// One mapped object, byte-aligned.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Mapped {
+    pub index: u16,
+    pub sub: u8,
+    pub bytes: u8,
+}
+
+impl Mapped {
+    /// Decodes `index << 16 | sub << 8 | bits`.
+    pub const fn decode(word: u32) -> (u16, u8, u8) {
+        ((word >> 16) as u16, (word >> 8) as u8, word as u8)
+    }
+
+    /// Dummy entries (indices 0002h..0007h) fill RPDO bytes nobody needs.
+    pub const fn is_dummy(&self) -> bool {
+        self.index < 0x0020
+    }
+}
+
+/// The bytes a dummy data type (CiA 301 7.4.7.1) occupies, if it can be mapped byte-aligned.
+const fn dummy_bytes(index: u16) -> Option<u8> {
+    match index {
+        0x0002 | 0x0005 => Some(1),
+        0x0003 | 0x0006 => Some(2),
+        0x0004 | 0x0007 => Some(4),
+        _ => None,
+    }
+}
+
+/// Checks one mapping entry against the dictionary (CiA 301 7.5.2.36): the object exists,
+/// may be mapped in this direction, and the length fits its type.
+pub fn check_entry(od: &impl ObjectDictionary, word: u32, dir: Dir) -> Result<Mapped, SdoAbort> {
+    let (index, sub, bits) = Mapped::decode(word);
+    if bits == 0 || bits % 8 != 0 {
+        // Only byte-aligned mapping is supported.
+        return Err(SdoAbort::NotMappable);
+    }
+    let bytes = bits / 8;
+    if let Some(size) = dummy_bytes(index) {
+        return if dir == Dir::Rx && size == bytes && sub == 0 { Ok(Mapped { index, sub, bytes }) } else { Err(SdoAbort::NotMappable) };
+    }
+    let e = od.entry(index, sub)?;
+    let allowed = match dir {
+        Dir::Rx => e.access.writable(),
+        Dir::Tx => e.access.readable(),
+    };
+    if !e.pdo_mappable || !allowed {
+        return Err(SdoAbort::NotMappable);
+    }
+    let variable = matches!(e.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
+    let fits = if variable { u16::from(bytes) <= e.size } else { u16::from(bytes) == e.size };
+    if fits { Ok(Mapped { index, sub, bytes }) } else { Err(SdoAbort::NotMappable) }
+}
+
+/// A PDO's mapping, checked and cached so that sending and receiving need no lookups of the
+/// mapping object.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Mapping {
+    entries: [Mapped; MAX_MAPPED],
+    count: u8,
+    bytes: u8,
+}
+
+impl Mapping {
+    /// Checks a whole mapping: every entry, and at most 64 bits in total.
+    pub fn check(od: &impl ObjectDictionary, words: &[u32], dir: Dir) -> Result<Mapping, SdoAbort> {
+        let mut m = Mapping::default();
+        for &w in words {
+            let e = check_entry(od, w, dir)?;
+            let total = m.bytes.saturating_add(e.bytes);
+            if total > 8 {
+                return Err(SdoAbort::PdoTooLong);
+            }
+            let slot = m.entries.get_mut(usize::from(m.count)).ok_or(SdoAbort::PdoTooLong)?;
+            *slot = e;
+            m.count += 1;
+            m.bytes = total;
+        }
+        Ok(m)
+    }
+
+    pub fn entries(&self) -> &[Mapped] {
+        self.entries.get(..usize::from(self.count)).unwrap_or(&[])
+    }
+
+    /// Mapped length in bytes.
+    pub const fn len(&self) -> u8 {
+        self.bytes
+    }
+
+    pub const fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    pub fn contains(&self, index: u16, sub: u8) -> bool {
+        self.entries().iter().any(|e| e.index == index && e.sub == sub)
+    }
+
+    /// Reads the mapped values into a frame payload; returns its length.
+    pub fn pack(&self, od: &mut impl ObjectDictionary, out: &mut [u8; 8]) -> Result<usize, SdoAbort> {
+        let mut at = 0;
+        for e in self.entries() {
+            let end = at + usize::from(e.bytes);
+            let dst = out.get_mut(at..end).ok_or(SdoAbort::PdoTooLong)?;
+            dst.fill(0);
+            od.read(e.index, e.sub, 0, dst, Side::Device)?;
+            at = end;
+        }
+        Ok(at)
+    }
+
+    /// Writes a received payload to the mapped objects; entries the dictionary refuses (a value
+    /// out of range) keep their value, the others are written. Returns the objects written.
+    pub fn unpack(&self, od: &mut impl ObjectDictionary, data: &[u8], mut written: impl FnMut(u16, u8)) {
+        let ctx = crate::od::AccessContext { nmt: crate::od::NmtState::Operational, can_enabled: true };
+        let mut at = 0;
+        for e in self.entries() {
+            let end = at + usize::from(e.bytes);
+            if let Some(src) = data.get(at..end)
+                && !e.is_dummy()
+                && od.write(e.index, e.sub, src, Side::Device, &ctx).is_ok()
+            {
+                written(e.index, e.sub);
+            }
+            at = end;
+        }
+    }
+}

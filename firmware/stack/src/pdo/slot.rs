@@ -1,0 +1,181 @@
+//! Runtime state of one RPDO or TPDO: its communication parameters (14xxh/18xxh), cached
+//! mapping, and the timers and buffers its transmission type needs.
+
+use super::{COB_EXTENDED, COB_INVALID, COB_NO_RTR, Dir, Mapping};
+use crate::od::ObjectDictionary;
+
+/// Communication parameters as read from 14xxh/18xxh.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Comm {
+    pub cob_id: u32,
+    pub transmission_type: u8,
+    /// Multiples of 100 us (sub 3).
+    pub inhibit_time: u16,
+    /// Milliseconds (sub 5).
+    pub event_timer: u16,
+    /// SYNC counter value that starts a synchronous TPDO (sub 6).
+    pub sync_start: u8,
+}
+
+impl Comm {
+    /// Reads the parameters of the PDO whose communication object is `index`; sub-entries
+    /// the spec leaves out read as 0.
+    pub fn read(od: &mut impl ObjectDictionary, index: u16) -> Comm {
+        let int = |od: &mut _, sub| crate::node::read_u32(od, index, sub).unwrap_or(0);
+        Comm {
+            cob_id: int(od, 1),
+            transmission_type: int(od, 2) as u8,
+            inhibit_time: int(od, 3) as u16,
+            event_timer: int(od, 5) as u16,
+            sync_start: int(od, 6) as u8,
+        }
+    }
+
+    /// Valid (bit 31 clear) and an 11-bit identifier.
+    pub const fn valid(&self) -> bool {
+        self.cob_id & (COB_INVALID | COB_EXTENDED) == 0
+    }
+
+    pub const fn id(&self) -> u16 {
+        (self.cob_id & 0x7FF) as u16
+    }
+
+    pub const fn rtr_allowed(&self) -> bool {
+        self.cob_id & COB_NO_RTR == 0
+    }
+
+    /// Transmission types 0..=240: acted on at SYNC.
+    pub const fn synchronous(&self) -> bool {
+        self.transmission_type <= 240
+    }
+
+    /// Transmission types 254 and 255: event-driven.
+    pub const fn event_driven(&self) -> bool {
+        self.transmission_type >= 254
+    }
+}
+
+/// Reads a mapping object (sub 0 = count, subs 1..=count the entries) and checks it; an
+/// invalid stored mapping counts as empty.
+pub fn read_mapping(od: &mut impl ObjectDictionary, index: u16, dir: Dir) -> Mapping {
+    let count = crate::node::read_u32(od, index, 0).unwrap_or(0).min(8) as u8;
+    let mut words = [0_u32; 8];
+    for (sub, w) in (1..=count).zip(words.iter_mut()) {
+        *w = crate::node::read_u32(od, index, sub).unwrap_or(0);
+    }
+    Mapping::check(od, words.get(..usize::from(count)).unwrap_or(&[]), dir).unwrap_or_default()
+}
+
+/// A receive PDO.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Rpdo {
+    /// 1400h + `offset` is its communication object.
+    pub offset: u16,
+    pub comm: Comm,
+    pub mapping: Mapping,
+    /// Data of a synchronous RPDO, applied at the next SYNC.
+    pub latched: Option<([u8; 8], u8)>,
+}
+
+impl Rpdo {
+    pub fn load(od: &mut impl ObjectDictionary, offset: u16) -> Rpdo {
+        let index = Dir::Rx.comm_base() + offset;
+        Rpdo { offset, comm: Comm::read(od, index), mapping: read_mapping(od, Dir::mapping_of(index), Dir::Rx), latched: None }
+    }
+}
+
+/// A transmit PDO.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Tpdo {
+    /// 1800h + `offset` is its communication object.
+    pub offset: u16,
+    pub comm: Comm,
+    pub mapping: Mapping,
+    /// An event is waiting for the inhibit time (254/255) or the next SYNC (0).
+    pub pending: bool,
+    /// No transmission before this time (inhibit time).
+    pub inhibit_until_us: u64,
+    /// When the event timer next fires.
+    pub event_due_us: Option<u64>,
+    /// SYNCs counted towards the next transmission (types 1..=240).
+    pub sync_count: u8,
+    /// Waiting for the SYNC counter to reach `sync_start`.
+    pub waiting_for_start: bool,
+    /// Data sampled at the last SYNC (type 252), sent on RTR.
+    pub sampled: Option<([u8; 8], u8)>,
+}
+
+impl Tpdo {
+    pub fn load(od: &mut impl ObjectDictionary, offset: u16, now_us: u64) -> Tpdo {
+        let index = Dir::Tx.comm_base() + offset;
+        let comm = Comm::read(od, index);
+        let mut t = Tpdo { offset, comm, mapping: read_mapping(od, Dir::mapping_of(index), Dir::Tx), ..Tpdo::default() };
+        t.restart(now_us);
+        t
+    }
+
+    /// Back to the state after configuration: event timer armed, counters cleared.
+    pub fn restart(&mut self, now_us: u64) {
+        self.pending = false;
+        self.sync_count = 0;
+        self.sampled = None;
+        self.waiting_for_start = self.comm.sync_start != 0;
+        self.inhibit_until_us = now_us;
+        self.event_due_us = (self.comm.event_driven() && self.comm.event_timer != 0).then(|| now_us + u64::from(self.comm.event_timer) * 1000);
+    }
+
+    /// Whether a SYNC with optional `counter` makes this TPDO send (types 0..=240), or
+    /// sample (252). Returns true if it should go out now.
+    pub fn on_sync(&mut self, counter: Option<u8>) -> bool {
+        let t = self.comm.transmission_type;
+        if self.waiting_for_start {
+            // CiA 301: with a SYNC counter, start counting at the SYNC whose counter equals sub 6.
+            match counter {
+                Some(c) if c == self.comm.sync_start => self.waiting_for_start = false,
+                Some(_) => return false,
+                None => self.waiting_for_start = false,
+            }
+        }
+        match t {
+            0 => core::mem::take(&mut self.pending),
+            1..=240 => {
+                self.sync_count = self.sync_count.saturating_add(1);
+                if self.sync_count >= t {
+                    self.sync_count = 0;
+                    true
+                } else {
+                    false
+                }
+            }
+            _ => false,
+        }
+    }
+
+    /// An application event (or a write to a mapped object).
+    pub fn trigger(&mut self) {
+        if matches!(self.comm.transmission_type, 0 | 254 | 255) {
+            self.pending = true;
+        }
+    }
+
+    /// Whether an event-driven TPDO should go out at `now_us` (event timer or a pending event,
+    /// inhibit time respected).
+    pub fn due(&mut self, now_us: u64) -> bool {
+        if !self.comm.event_driven() {
+            return false;
+        }
+        if self.event_due_us.is_some_and(|t| now_us >= t) {
+            self.pending = true;
+        }
+        self.pending && now_us >= self.inhibit_until_us
+    }
+
+    /// Records a transmission at `now_us`: inhibit time and event timer restart.
+    pub fn sent(&mut self, now_us: u64) {
+        self.pending = false;
+        self.inhibit_until_us = now_us + u64::from(self.comm.inhibit_time) * 100;
+        if self.comm.event_driven() && self.comm.event_timer != 0 {
+            self.event_due_us = Some(now_us + u64::from(self.comm.event_timer) * 1000);
+        }
+    }
+}

@@ -1,0 +1,281 @@
+//! SDO server (CiA 301 7.2.4): expedited, segmented and block transfer, both directions.
+//!
+//! The server sees the dictionary only through [`SdoTarget`]; the node implements it over the
+//! generated dictionary plus its communication-object hooks, so every abort code the
+//! dictionary produces reaches the client unchanged.
+//!
+//! [`SdoServer`] is poll-driven like the rest of the stack: the node hands it each request
+//! (COB-ID 600h + node ID) with [`SdoServer::on_request`] and sends the response it returns
+//! (on 580h + node ID), and calls [`SdoServer::poll`] every cycle for what the server sends on
+//! its own: block upload segments, one per call, and the abort of a timed-out transfer.
+//!
+//! A download is collected in the server's `N`-byte buffer and written to the target in one
+//! call once complete, so a refused or aborted download changes nothing. An upload reads the
+//! value by offset, a segment at a time, and needs no buffer.
+//!
+//! Choices where CiA 301 leaves room, so a client can rely on them:
+//!
+//! - **Short requests**: a request of fewer than 8 bytes is read as if the missing bytes
+//!   were 0; bytes past the eighth are ignored.
+//! - **Expedited download without size** (`e = 1, s = 0`): the size is unspecified, so all
+//!   four data bytes are written and the dictionary's length check decides.
+//! - **Indicated size versus data** (segmented and block download): more data than
+//!   indicated aborts with `LengthTooHigh` (0607 0012h), less with `LengthTooLow`
+//!   (0607 0013h), rather than the generic `LengthMismatch`. Segmented download aborts as
+//!   soon as a segment goes past the indicated size; block download checks at its end.
+//! - **More than `N` bytes**: the target is asked whether it would take that many; its own
+//!   code (typically `LengthTooHigh`) is sent if it refuses, `OutOfMemory` (0504 0005h)
+//!   otherwise. An expedited download carries its data in the frame and needs no buffer.
+//! - **Out-of-context commands**: a segment, block sub-command or end when no transfer (or
+//!   a different one) is in progress, or after the last segment, aborts with
+//!   `UnknownCommand` (0504 0001h), as does ccs = 7. The abort names the transfer's object,
+//!   or with no transfer the request's bytes 1..=3 for ccs = 7 and 0000h.00 for a stray
+//!   segment (whose bytes 1..=3 are data, not a multiplexer). A transfer in progress ends.
+//! - **New initiate during a transfer**: the old transfer is dropped silently (nothing
+//!   written) and the new one starts, as CANopenNode does: the client evidently gave up on
+//!   the old one. The exception is a block download's sub-block, where every frame is a
+//!   segment by definition.
+//! - **Client abort** (ccs = 4): the transfer is dropped, nothing is sent. During a block
+//!   download sub-block, byte 0 = 80h is read as the client's abort: as a segment it would
+//!   be sequence number 0, which no valid segment carries.
+//! - **Block sizes**: the download block size is what fits the free buffer (`free / 7`),
+//!   1..=127, announced again in every acknowledgement. A client block size of 0 or above
+//!   127 aborts with `InvalidBlockSize` (0504 0002h).
+//! - **Lost block download segments**: sequence number 0 aborts with `InvalidSequence`
+//!   (0504 0003h); any other out-of-order number makes the server ignore the rest of the
+//!   sub-block and, when the sub-block ends (its last number or `c = 1`), acknowledge the
+//!   last in-order segment so the client resends from there.
+//! - **Block upload acknowledgement** of more segments than were sent aborts with
+//!   `InvalidSequence`. The end request follows an acknowledgement of the last segment
+//!   directly as its response.
+//! - **CRC**: the server always offers CRC; it is checked and sent only if the client
+//!   offers it too. The upload CRC is accumulated as each segment is first sent.
+//! - **Empty upload**: a value of 0 bytes is uploaded segmented (size 0, one empty last
+//!   segment), since an expedited response with size indicated cannot say 0 bytes.
+//! - **A value that changes length during an upload** so that the announced size cannot be
+//!   kept aborts with `General` (0800 0000h).
+//! - **Timeout**: a transfer with no client frame for the timeout (elapsed >= timeout; 1 s
+//!   by default) is aborted by `poll` with `Timeout` (0504 0000h). While the server sends a
+//!   block upload sub-block it is not waiting, so each segment sent restarts the clock.
+
+mod block;
+mod command;
+mod segmented;
+
+use crate::od::{ReadLen, SdoAbort};
+use command::{BlockSegment, Mux, Request};
+
+/// What the SDO server reads and writes.
+pub trait SdoTarget {
+    /// Reads the value of `index`/`sub` from byte `offset` into `buf`; `total` is the
+    /// value's full length. Includes the read access check.
+    fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
+
+    /// Whether a download of `size` bytes (if the client indicated one) could be written:
+    /// the object exists, is writable now, and `size` does not exceed its maximum. Lets the
+    /// server refuse at initiation instead of after the last segment.
+    fn check_download(&mut self, index: u16, sub: u8, size: Option<usize>) -> Result<(), SdoAbort>;
+
+    /// Writes the whole value; a refused write changes nothing.
+    fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
+}
+
+/// The default SDO timeout: 1 s.
+pub const DEFAULT_TIMEOUT_US: u64 = 1_000_000;
+
+/// The transfer in progress, if any.
+#[derive(Debug)]
+enum State {
+    Idle,
+    Download(segmented::Download),
+    Upload(segmented::Upload),
+    BlockDownload(block::Download),
+    BlockUpload(block::Upload),
+}
+
+impl State {
+    /// The object of the transfer in progress.
+    fn mux(&self) -> Option<Mux> {
+        match self {
+            State::Idle => None,
+            State::Download(t) => Some(t.mux),
+            State::Upload(t) => Some(t.mux),
+            State::BlockDownload(t) => Some(t.mux),
+            State::BlockUpload(t) => Some(t.mux),
+        }
+    }
+}
+
+/// What a request within a transfer leads to.
+#[derive(Debug)]
+enum Step {
+    /// Send this frame, if any; the transfer goes on.
+    Continue(Option<[u8; 8]>),
+    /// Send this frame, if any; the transfer is complete.
+    Finish(Option<[u8; 8]>),
+}
+
+/// An initiation: the new state and the initiate response, or the abort code.
+type Started = Result<(State, [u8; 8]), SdoAbort>;
+
+/// The abort for a download that outgrows the buffer: the dictionary's own code if the object
+/// could not take that many bytes either, `OutOfMemory` if only the buffer is too small.
+fn too_long(target: &mut impl SdoTarget, mux: Mux, len: usize) -> SdoAbort {
+    match target.check_download(mux.index, mux.sub, Some(len)) {
+        Err(code) => code,
+        Ok(()) => SdoAbort::OutOfMemory,
+    }
+}
+
+/// A CiA 301 SDO server with an `N`-byte download buffer (the largest value a client can
+/// write with a segmented or block download).
+#[derive(Debug)]
+pub struct SdoServer<const N: usize> {
+    state: State,
+    timeout_us: u64,
+    /// When the client last sent a frame, or the server a block segment: the timeout runs
+    /// from here.
+    last_us: u64,
+    /// A download collects here and reaches the target only once complete.
+    buf: [u8; N],
+}
+
+impl<const N: usize> Default for SdoServer<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> SdoServer<N> {
+    /// An idle server with the default timeout of 1 s.
+    pub const fn new() -> Self {
+        SdoServer { state: State::Idle, timeout_us: DEFAULT_TIMEOUT_US, last_us: 0, buf: [0; N] }
+    }
+
+    /// How long a transfer may wait for the client before `poll` aborts it.
+    pub fn set_timeout_us(&mut self, us: u64) {
+        self.timeout_us = us;
+    }
+
+    /// Whether no transfer is in progress.
+    pub fn is_idle(&self) -> bool {
+        matches!(self.state, State::Idle)
+    }
+
+    /// Drops any transfer silently (NMT reset or stop): nothing is written or sent.
+    pub fn reset(&mut self) {
+        self.state = State::Idle;
+    }
+
+    /// A received request (the payload of a CAN frame on COB-ID 600h + node ID). Returns the
+    /// response payload if one is due: always 8 bytes, a valid SDO response or an abort.
+    pub fn on_request(&mut self, data: &[u8], now_us: u64, target: &mut impl SdoTarget) -> Option<[u8; 8]> {
+        let frame = command::pad(data);
+        self.last_us = now_us;
+        if let State::BlockDownload(down) = &mut self.state
+            && down.receiving()
+            && !command::is_abort(&frame)
+        {
+            let mux = down.mux;
+            let step = down.segment(&BlockSegment::parse(&frame), &mut self.buf, target);
+            return self.step(mux, step);
+        }
+        let current = self.state.mux();
+        match (Request::parse(&frame), &mut self.state) {
+            (Request::Abort, _) => {
+                self.state = State::Idle;
+                None
+            }
+            (Request::InitiateDownload(init), _) => {
+                let started = segmented::initiate_download(&init, N, target);
+                self.start(init.mux, started)
+            }
+            (Request::InitiateUpload { mux }, _) => {
+                let started = segmented::initiate_upload(mux, target);
+                self.start(mux, started)
+            }
+            (Request::BlockDownloadInitiate { mux, crc, size }, _) => {
+                let started = block::initiate_download(mux, crc, size, N, target);
+                self.start(mux, started)
+            }
+            (Request::BlockUploadInitiate { mux, crc, blksize, pst }, _) => {
+                let started = block::initiate_upload(mux, crc, blksize, pst, target);
+                self.start(mux, started)
+            }
+            (Request::DownloadSegment(seg), State::Download(down)) => {
+                let (mux, step) = (down.mux, down.segment(&seg, &mut self.buf, target));
+                self.step(mux, step)
+            }
+            (Request::UploadSegment { toggle }, State::Upload(up)) => {
+                let (mux, step) = (up.mux, up.segment(toggle, target));
+                self.step(mux, step)
+            }
+            (Request::BlockDownloadEnd { n, crc }, State::BlockDownload(down)) => {
+                let (mux, step) = (down.mux, down.end(n, crc, &self.buf, target));
+                self.step(mux, step)
+            }
+            (Request::BlockUploadStart, State::BlockUpload(up)) => {
+                let (mux, step) = (up.mux, up.start());
+                self.step(mux, step)
+            }
+            (Request::BlockUploadAck { ackseq, blksize }, State::BlockUpload(up)) => {
+                let (mux, step) = (up.mux, up.ack(ackseq, blksize));
+                self.step(mux, step)
+            }
+            (Request::BlockUploadEnd, State::BlockUpload(up)) => {
+                let (mux, step) = (up.mux, up.end());
+                self.step(mux, step)
+            }
+            (Request::Unknown { mux }, _) => self.abort(current.unwrap_or(mux), SdoAbort::UnknownCommand),
+            // A segment or block sub-command that does not belong to the transfer in progress.
+            _ => self.abort(current.unwrap_or_default(), SdoAbort::UnknownCommand),
+        }
+    }
+
+    /// Called every poll: the next frame the server sends on its own (a block upload
+    /// segment, one per call; the `Timeout` abort of a transfer the client left waiting).
+    pub fn poll(&mut self, now_us: u64, target: &mut impl SdoTarget) -> Option<[u8; 8]> {
+        let mux = self.state.mux()?;
+        if let State::BlockUpload(up) = &mut self.state {
+            match up.next_segment(target) {
+                Ok(Some(frame)) => {
+                    self.last_us = now_us;
+                    return Some(frame);
+                }
+                Ok(None) => {}
+                Err(code) => return self.abort(mux, code),
+            }
+        }
+        if now_us.saturating_sub(self.last_us) >= self.timeout_us {
+            return self.abort(mux, SdoAbort::Timeout);
+        }
+        None
+    }
+
+    fn start(&mut self, mux: Mux, started: Started) -> Option<[u8; 8]> {
+        match started {
+            Ok((state, response)) => {
+                self.state = state;
+                Some(response)
+            }
+            Err(code) => self.abort(mux, code),
+        }
+    }
+
+    fn step(&mut self, mux: Mux, step: Result<Step, SdoAbort>) -> Option<[u8; 8]> {
+        match step {
+            Ok(Step::Continue(response)) => response,
+            Ok(Step::Finish(response)) => {
+                self.state = State::Idle;
+                response
+            }
+            Err(code) => self.abort(mux, code),
+        }
+    }
+
+    /// Ends the transfer with an abort frame.
+    fn abort(&mut self, mux: Mux, code: SdoAbort) -> Option<[u8; 8]> {
+        self.state = State::Idle;
+        Some(command::abort_frame(mux, code))
+    }
+}
