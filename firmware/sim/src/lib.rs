@@ -4,6 +4,7 @@
 //! - [`slcan`]: the Lawicel ASCII protocol, an encoder and a streaming decoder that never panics;
 //! - [`hub`]: the bus, a TCP SLCAN listener plus in-process [`hub::Port`]s;
 //! - [`devices`]: the four coforge devices as [`devices::SimNode`]s, by name;
+//! - [`runner`]: real-time nodes on a hub, one thread for all of them;
 //! - [`vbus`]: a deterministic in-process bus on a virtual clock, for tests;
 //! - [`storage`], [`app`]: parameter storage (memory or file) and app-backed objects.
 #![forbid(unsafe_code)]
@@ -13,6 +14,7 @@
 pub mod app;
 pub mod devices;
 pub mod hub;
+pub mod runner;
 pub mod slcan;
 pub mod storage;
 pub mod vbus;

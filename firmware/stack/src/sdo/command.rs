@@ -125,17 +125,38 @@ impl BlockSegment {
 pub(super) enum Request {
     DownloadSegment(Segment),
     InitiateDownload(InitDownload),
-    InitiateUpload { mux: Mux },
-    UploadSegment { toggle: bool },
+    InitiateUpload {
+        mux: Mux,
+    },
+    UploadSegment {
+        toggle: bool,
+    },
     Abort,
-    BlockUploadInitiate { mux: Mux, crc: bool, blksize: u8, pst: u8 },
+    BlockUploadInitiate {
+        mux: Mux,
+        crc: bool,
+        blksize: u8,
+        pst: u8,
+    },
     BlockUploadStart,
-    BlockUploadAck { ackseq: u8, blksize: u8 },
+    BlockUploadAck {
+        ackseq: u8,
+        blksize: u8,
+    },
     BlockUploadEnd,
-    BlockDownloadInitiate { mux: Mux, crc: bool, size: Option<u32> },
-    BlockDownloadEnd { n: u8, crc: u16 },
+    BlockDownloadInitiate {
+        mux: Mux,
+        crc: bool,
+        size: Option<u32>,
+    },
+    BlockDownloadEnd {
+        n: u8,
+        crc: u16,
+    },
     /// ccs = 7: no such command; `mux` is bytes 1..=3 taken at face value.
-    Unknown { mux: Mux },
+    Unknown {
+        mux: Mux,
+    },
 }
 
 impl Request {
