@@ -12,6 +12,7 @@
 
 pub mod framing;
 pub mod integrity;
+pub mod node;
 
 #[cfg(kani)]
 mod harnesses;

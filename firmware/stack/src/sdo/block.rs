@@ -104,7 +104,7 @@ impl Download {
 
     /// The end request: `n` bytes of the last segment carried no data. Checks the length
     /// (buffer, then the indicated size) and the CRC if negotiated, then writes.
-    pub(super) fn end(&mut self, n: u8, crc: u16, buf: &[u8], target: &mut impl SdoTarget) -> Result<Step, SdoAbort> {
+    pub(super) fn end(&self, n: u8, crc: u16, buf: &[u8], target: &mut impl SdoTarget) -> Result<Step, SdoAbort> {
         let len = self.received.saturating_sub(usize::from(n));
         let Some(data) = buf.get(..len) else { return Err(too_long(target, self.mux, len)) };
         match self.size {

@@ -45,6 +45,8 @@
 //!   (0504 0003h); any other out-of-order number makes the server ignore the rest of the
 //!   sub-block and, when the sub-block ends (its last number or `c = 1`), acknowledge the
 //!   last in-order segment so the client resends from there.
+//!   If the sub-block's last segment itself is lost, no acknowledgement is due and the
+//!   transfer ends by timeout.
 //! - **Block upload acknowledgement** of more segments than were sent aborts with
 //!   `InvalidSequence`. The end request follows an acknowledgement of the last segment
 //!   directly as its response.

@@ -1,0 +1,176 @@
+//! The CANopen node under arbitrary bus traffic: any identifier, DLC 0..8, data or remote,
+//! at any time steps, in every NMT state and SDO transfer phase the traffic reaches.
+//!
+//! Invariants ([`prop_node_frames`]):
+//! - nothing panics;
+//! - no read-only or const entry changes (except the ones the stack itself maintains:
+//!   1001h error register, 1003h error history);
+//! - every SDO answer is a valid server response or an abort with a CiA 301 code.
+
+use coforge_stack::frame::CanFrame;
+use coforge_stack::od::{Access, EntryInfo, NoAppObjects, SdoAbort, Side};
+use coforge_stack::store::BlockStore;
+use embedded_storage::{ReadStorage, Storage};
+
+/// An EEPROM image in RAM (erased to 0xFF).
+#[derive(Debug)]
+pub struct RamStorage<const N: usize>(pub [u8; N]);
+
+impl<const N: usize> ReadStorage for RamStorage<N> {
+    type Error = ();
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), ()> {
+        let start = usize::try_from(offset).map_err(|_| ())?;
+        bytes.copy_from_slice(self.0.get(start..start.checked_add(bytes.len()).ok_or(())?).ok_or(())?);
+        Ok(())
+    }
+    fn capacity(&self) -> usize {
+        N
+    }
+}
+
+impl<const N: usize> Storage for RamStorage<N> {
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), ()> {
+        let start = usize::try_from(offset).map_err(|_| ())?;
+        self.0.get_mut(start..start.checked_add(bytes.len()).ok_or(())?).ok_or(())?.copy_from_slice(bytes);
+        Ok(())
+    }
+}
+
+const NODE_ID: u8 = 5;
+const STORE: usize = 2048;
+/// Entries the stack writes itself although the bus may not.
+const STACK_MAINTAINED: [u16; 2] = [0x1001, 0x1003];
+/// Bytes of a read-only value kept for comparison.
+const VALUE: usize = 32;
+const MAX_WATCHED: usize = 600;
+
+/// Identifiers the traffic is steered towards, so short inputs reach the services.
+const IDS: [u16; 8] = [0x000, 0x080, 0x605, 0x705, 0x205, 0x305, 0x185, 0x285];
+
+/// One frame from 12 input bytes: time step, identifier choice, flags, data.
+fn frame_of(chunk: &[u8]) -> (u64, Option<CanFrame>) {
+    let b = |i: usize| chunk.get(i).copied().unwrap_or(0);
+    let step_us = u64::from(b(0)) * 997;
+    let id = match b(1) {
+        s @ 0..=199 => IDS.get(usize::from(s % 8)).copied().unwrap_or(0),
+        _ => u16::from_le_bytes([b(2), b(3)]) & 0x7FF,
+    };
+    let dlc = b(3) >> 4 & 0x0F;
+    let rtr = b(3) & 0x08 != 0;
+    let data = [b(4), b(5), b(6), b(7), b(8), b(9), b(10), b(11)];
+    let frame = if rtr { CanFrame::remote(id, dlc.min(8)) } else { CanFrame::data(id, data.get(..usize::from(dlc.min(8))).unwrap_or(&[])) };
+    (step_us, frame)
+}
+
+/// A valid SDO server frame (CiA 301 7.2.4.3). During a block upload the server's segments
+/// start with any sequence number, so only an abort (seqno 0 is never valid) is checked.
+fn valid_sdo_answer(data: &[u8; 8], block_upload: bool) -> bool {
+    let abort_ok = || SdoAbort::from_code(u32::from_le_bytes([data[4], data[5], data[6], data[7]])).is_some();
+    if block_upload {
+        return data[0] != 0x80 || abort_ok();
+    }
+    match data[0] >> 5 {
+        // Upload segment, download response, upload initiate, download segment response.
+        0..=3 => true,
+        4 => data[0] == 0x80 && abort_ok(),
+        // Block download / upload server frames.
+        5 | 6 => true,
+        _ => false,
+    }
+}
+
+macro_rules! run_device {
+    ($krate:ident, $input:expr) => {{
+        let od = $krate::Od::new($krate::Mode::ALL[0], NODE_ID, NoAppObjects);
+        let store = BlockStore::new(RamStorage([0xFF; STORE]), 0);
+        let mut node: $krate::Node<NoAppObjects, BlockStore<RamStorage<STORE>>> = coforge_stack::node::Node::new(od, store, $krate::node_config(NODE_ID));
+        let entries = $krate::od::entries($krate::Mode::ALL[0]);
+        drive(&mut node, entries, $input);
+    }};
+}
+
+/// Checks the invariants for one input; the first byte picks the device.
+pub fn prop_node_frames(input: &[u8]) {
+    let Some((&pick, rest)) = input.split_first() else { return };
+    match pick % 3 {
+        0 => run_device!(co401gw1, rest),
+        1 => run_device!(cr3101, rest),
+        _ => run_device!(canopenia, rest),
+    }
+}
+
+trait Driven {
+    fn start(&mut self, now: u64);
+    fn on_frame(&mut self, f: &CanFrame, now: u64);
+    fn poll(&mut self, now: u64) -> Option<CanFrame>;
+    fn read_device(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Option<usize>;
+}
+
+impl<D: coforge_stack::od::Dictionary, S: coforge_stack::store::ParamStore, const N: usize, const P: usize> Driven for coforge_stack::node::Node<D, S, N, P> {
+    fn start(&mut self, now: u64) {
+        coforge_stack::node::Node::start(self, now);
+    }
+    fn on_frame(&mut self, f: &CanFrame, now: u64) {
+        coforge_stack::node::Node::on_frame(self, f, now);
+    }
+    fn poll(&mut self, now: u64) -> Option<CanFrame> {
+        coforge_stack::node::Node::poll(self, now)
+    }
+    fn read_device(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Option<usize> {
+        self.read(index, sub, 0, buf, Side::Device).ok().map(|r| r.copied)
+    }
+}
+
+type Snapshot = ([(u16, u8, usize, [u8; VALUE]); MAX_WATCHED], usize);
+
+fn snapshot(node: &mut impl Driven, entries: &[EntryInfo]) -> Snapshot {
+    let mut out = ([(0, 0, 0, [0; VALUE]); MAX_WATCHED], 0);
+    let watched = entries.iter().filter(|e| matches!(e.access, Access::Ro | Access::Const) && !STACK_MAINTAINED.contains(&e.index));
+    for e in watched {
+        for sub in e.sub..=e.last_sub {
+            let mut buf = [0; VALUE];
+            if let Some(n) = node.read_device(e.index, sub, &mut buf)
+                && let Some(slot) = out.0.get_mut(out.1)
+            {
+                *slot = (e.index, sub, n, buf);
+                out.1 += 1;
+            }
+        }
+    }
+    out
+}
+
+fn drive(node: &mut impl Driven, entries: &[EntryInfo], input: &[u8]) {
+    node.start(0);
+    let before = snapshot(node, entries);
+    let mut now = 0_u64;
+    let mut block_upload = false;
+    for chunk in input.chunks(12) {
+        let (step, frame) = frame_of(chunk);
+        now += step;
+        if let Some(f) = frame {
+            // A block upload continues only with block-upload client frames (ccs 5).
+            if f.id == 0x600 + u16::from(NODE_ID) && f.data[0] >> 5 != 5 {
+                block_upload = false;
+            }
+            node.on_frame(&f, now);
+        }
+        // A bounded drain: a node never has more than a few frames per event.
+        for _ in 0..256 {
+            let Some(out) = node.poll(now) else { break };
+            if out.id == 0x580 + u16::from(NODE_ID) {
+                assert!(valid_sdo_answer(&out.data, block_upload), "invalid SDO answer {:02X?}", out.data);
+                if out.data[0] == 0x80 {
+                    block_upload = false;
+                } else if out.data[0] >> 5 == 6 && out.data[0] & 0x01 == 0 && !block_upload {
+                    block_upload = true;
+                }
+            }
+        }
+    }
+    let after = snapshot(node, entries);
+    assert_eq!(before.1, after.1, "read-only entries appeared or vanished");
+    for (b, a) in before.0.iter().zip(after.0.iter()).take(before.1) {
+        assert_eq!(b, a, "read-only entry {:04X}h.{} changed", b.0, b.1);
+    }
+}
