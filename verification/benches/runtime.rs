@@ -53,5 +53,24 @@ fn codecs(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, dictionary, codecs);
+/// One request into a CO401GW1 node in Operational, through to the frames it answers with.
+fn node(c: &mut Criterion) {
+    use coforge_verification::node::requests;
+    let mut n = requests::node(255);
+    c.bench_function("node/co401gw1/sdo_expedited_upload", |b| b.iter(|| requests::sdo_upload(black_box(&mut n))));
+    c.bench_function("node/co401gw1/sdo_expedited_download", |b| b.iter(|| requests::sdo_download(black_box(&mut n))));
+    c.bench_function("node/co401gw1/rpdo", |b| b.iter(|| requests::rpdo(black_box(&mut n))));
+    let mut t = 0;
+    c.bench_function("node/co401gw1/tpdo_event", |b| {
+        b.iter(|| {
+            t += 1;
+            requests::tpdo_event(black_box(&mut n), t)
+        })
+    });
+    let mut s = requests::node(1);
+    c.bench_function("node/co401gw1/sync_2_tpdos", |b| b.iter(|| requests::sync(black_box(&mut s))));
+    println!("size_of Node<co401gw1> = {} bytes", core::mem::size_of::<requests::GwNode>());
+}
+
+criterion_group!(benches, dictionary, codecs, node);
 criterion_main!(benches);

@@ -174,3 +174,64 @@ fn drive(node: &mut impl Driven, entries: &[EntryInfo], input: &[u8]) {
         assert_eq!(b, a, "read-only entry {:04X}h.{} changed", b.0, b.1);
     }
 }
+
+/// The requests the performance figures are taken for, on a CO401GW1 node (node-ID 5) in
+/// Operational with TPDO1 and TPDO2 valid. Shared by the criterion bench and the callgrind
+/// example so both measure the same work.
+pub mod requests {
+    use super::{BlockStore, CanFrame, NODE_ID, NoAppObjects, RamStorage, STORE};
+    use coforge_stack::od::Side;
+
+    pub type GwNode = co401gw1::Node<NoAppObjects, BlockStore<RamStorage<STORE>>>;
+
+    /// A started node; TPDO1 and TPDO2 use `transmission_type`.
+    pub fn node(transmission_type: u8) -> GwNode {
+        let od = co401gw1::Od::new(co401gw1::Mode::Mixed, NODE_ID, NoAppObjects);
+        let mut node: GwNode = coforge_stack::node::Node::new(od, BlockStore::new(RamStorage([0xFF; STORE]), 0), co401gw1::node_config(NODE_ID));
+        node.start(0);
+        for index in [0x1800_u16, 0x1801] {
+            let _ = node.write(index, 2, &[transmission_type], Side::Device);
+        }
+        node.on_frame(&frame(0x000, &[0x01, 0]), 0);
+        drain(&mut node, 0);
+        node
+    }
+
+    fn frame(id: u16, data: &[u8]) -> CanFrame {
+        CanFrame::data(id, data).unwrap_or(CanFrame { id: 0, rtr: false, dlc: 0, data: [0; 8] })
+    }
+
+    /// Polls until the node is quiet; returns the frames sent.
+    pub fn drain(node: &mut GwNode, now: u64) -> usize {
+        let mut n = 0;
+        while node.poll(now).is_some() {
+            n += 1;
+        }
+        n
+    }
+
+    pub fn sdo_upload(node: &mut GwNode) -> usize {
+        node.on_frame(&frame(0x605, &[0x40, 0x17, 0x10, 0, 0, 0, 0, 0]), 1);
+        drain(node, 1)
+    }
+
+    pub fn sdo_download(node: &mut GwNode) -> usize {
+        node.on_frame(&frame(0x605, &[0x2B, 0x17, 0x10, 0, 0xE8, 0x03, 0, 0]), 1);
+        drain(node, 1)
+    }
+
+    pub fn rpdo(node: &mut GwNode) -> usize {
+        node.on_frame(&frame(0x205, &[1, 2, 3, 4, 5, 6, 7, 8]), 1);
+        drain(node, 1)
+    }
+
+    pub fn tpdo_event(node: &mut GwNode, now: u64) -> usize {
+        node.trigger_tpdo(1);
+        drain(node, now)
+    }
+
+    pub fn sync(node: &mut GwNode) -> usize {
+        node.on_frame(&frame(0x080, &[]), 1);
+        drain(node, 1)
+    }
+}

@@ -117,20 +117,35 @@ fn cr3101_and_canopenia_dictionaries_sweep() {
 #[test]
 fn co401gw1_persistent_block_saves_loads_and_restores() {
     use co401gw1::{Mode, Od};
+    use coforge_stack::od::{Area, Dictionary};
+    let size = <Od<Memory> as Dictionary>::PERSISTENT_SIZE;
     let mut a = Od::new(Mode::Mixed, 5, memory());
     assert_eq!(a.write(0x100C, 0, &[0xF4, 0x01], Side::Bus, &PREOP), Ok(()));
     assert_eq!(a.write(0x1800, 1, &[0x85, 0x03, 0, 0], Side::Bus, &PREOP), Ok(()), "TPDO1 COB-ID is persistent");
-    let mut block = vec![0_u8; Od::<Memory>::PERSISTENT_SIZE];
-    assert_eq!(a.save_persistent(&mut block), Some(block.len()));
-    assert_eq!(a.save_persistent(&mut [0; 3]), None, "a short buffer is refused");
+    assert_eq!(a.write(0x2180, 0, &[0x10, 0x27], Side::Bus, &PREOP), Ok(()), "manufacturer area");
+    let save = |od: &Od<Memory>, area, block: &mut Vec<u8>| {
+        od.save_area(area, &mut |at, image| {
+            block[at..at + image.len()].copy_from_slice(image);
+            true
+        })
+    };
+    let mut block = vec![0xEE_u8; size];
+    assert!(save(&a, Area::ALL, &mut block));
+    assert!(block.iter().filter(|&&b| b == 0xEE).count() < 4, "every byte of the block is written");
+    let mut comm_only = vec![0xEE_u8; size];
+    assert!(save(&a, Area::COMMUNICATION, &mut comm_only));
+    assert!(comm_only.contains(&0xEE), "other areas are left as they were");
     let mut b = Od::new(Mode::Mixed, 5, memory());
-    assert!(!b.load_persistent(&block[..block.len() - 1]));
-    assert_eq!(b.guard_time, 0, "a short block changes nothing");
-    assert!(b.load_persistent(&block));
+    assert!(!b.load_area(Area::ALL, &mut |_, _| false), "a source that fails is reported");
+    assert!(b.load_area(Area::COMMUNICATION, &mut |at, buf| {
+        buf.copy_from_slice(&block[at..at + buf.len()]);
+        true
+    }));
     assert_eq!(b.guard_time, 500);
     assert_eq!(read(&mut b, 0x1800, 1, Side::Bus), Ok(vec![0x85, 0x03, 0, 0]));
-    b.restore_defaults(7);
+    assert_eq!(read(&mut b, 0x2180, 0, Side::Bus), Ok(vec![0xE8, 0x03]), "manufacturer area not loaded");
+    b.reset_area(Area::COMMUNICATION, 7);
     assert_eq!(b.guard_time, 0);
     assert_eq!(read(&mut b, 0x1800, 1, Side::Bus), Ok(vec![0x87, 0x01, 0, 0]), "defaults with $NODEID for node 7");
-    const { assert!(Od::<Memory>::PERSISTENT_SIZE > 40) };
+    const { assert!(<Od<Memory> as Dictionary>::PERSISTENT_SIZE > 40) };
 }

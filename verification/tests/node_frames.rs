@@ -25,11 +25,11 @@ fn every_sdo_phase_under_garbage() {
     // Selector 2 = SDO request 0x605, flags 0x80 = DLC 8.
     let sdo = |data| frame(1, 2, 0x80, data);
     let phases: [[u8; 8]; 5] = [
-        [0x40, 0x08, 0x10, 0, 0, 0, 0, 0],      // segmented upload of 1008h
-        [0x21, 0x17, 0x10, 0, 8, 0, 0, 0],      // segmented download announced
-        [0xC6, 0x17, 0x10, 0, 2, 0, 0, 0],      // block download initiate
-        [0xA4, 0x08, 0x10, 0, 10, 0, 0, 0],     // block upload initiate
-        [0x00, 0x01, 0x02, 0x03, 0, 0, 0, 0],   // a stray segment
+        [0x40, 0x08, 0x10, 0, 0, 0, 0, 0],    // segmented upload of 1008h
+        [0x21, 0x17, 0x10, 0, 8, 0, 0, 0],    // segmented download announced
+        [0xC6, 0x17, 0x10, 0, 2, 0, 0, 0],    // block download initiate
+        [0xA4, 0x08, 0x10, 0, 10, 0, 0, 0],   // block upload initiate
+        [0x00, 0x01, 0x02, 0x03, 0, 0, 0, 0], // a stray segment
     ];
     for device in 0..3_u8 {
         for phase in phases {

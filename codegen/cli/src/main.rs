@@ -138,7 +138,12 @@ fn sim(device: &str, first_id: u8, port: u16, mode: Option<&str>, store: Option<
     let hub = coforge_sim::hub::Hub::bind(("127.0.0.1", port)).map_err(|e| format!("cannot listen on port {port}: {e}"))?;
     let running = coforge_sim::runner::spawn(&hub, nodes);
     // Tests and scripts wait for this line before connecting.
-    println!("coforge sim: {} node-ID {first_id}{} on slcan socket://{}", kind.name, if count > 1 { format!("..{}", first_id + count - 1) } else { String::new() }, hub.local_addr());
+    println!(
+        "coforge sim: {} node-ID {first_id}{} on slcan socket://{}",
+        kind.name,
+        if count > 1 { format!("..{}", first_id + count - 1) } else { String::new() },
+        hub.local_addr()
+    );
     use std::io::Write as _;
     let _ = std::io::stdout().flush();
     match seconds {

@@ -158,15 +158,7 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     // The SDO server buffers a download until its last segment: size the buffer for the
     // largest value the bus may write. Domains without a declared length do not count; a
     // download larger than the buffer is refused with "out of memory".
-    let max_write = d
-        .objects
-        .iter()
-        .flat_map(|o| &o.entries)
-        .filter(|e| e.access.writable() && size_of(e) != u16::MAX)
-        .map(size_of)
-        .max()
-        .unwrap_or(4)
-        .max(4);
+    let max_write = d.objects.iter().flat_map(|o| &o.entries).filter(|e| e.access.writable() && size_of(e) != u16::MAX).map(size_of).max().unwrap_or(4).max(4);
     let max_write = crate::dec(max_write.into());
     quote! {
         /// Object dictionary metadata, generated from the spec.

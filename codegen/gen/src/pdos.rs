@@ -61,9 +61,7 @@ pub fn pdo_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let slots = modes
         .variants
         .iter()
-        .flat_map(|(_, mode)| {
-            [PdoDir::Rx, PdoDir::Tx].map(|dir| d.pdo.pdos.iter().filter(|p| p.dir == dir && in_mode(&p.modes, mode.as_deref())).count())
-        })
+        .flat_map(|(_, mode)| [PdoDir::Rx, PdoDir::Tx].map(|dir| d.pdo.pdos.iter().filter(|p| p.dir == dir && in_mode(&p.modes, mode.as_deref())).count()))
         .max()
         .unwrap_or(0);
     let slots = crate::dec(slots as u64);

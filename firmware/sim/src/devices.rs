@@ -87,13 +87,16 @@ pub enum StoreAt {
     File(PathBuf),
 }
 
+/// Builds a node of one device: mode name, node-ID, parameter storage.
+type Build = fn(Option<&str>, u8, MemStorage) -> Result<Box<dyn SimNode>, String>;
+
 /// A device the simulator can run.
 #[derive(Debug, Clone, Copy)]
 pub struct DeviceKind {
     pub name: &'static str,
     /// Mode names from the spec (the first is the default).
     pub modes: fn() -> Vec<&'static str>,
-    build: fn(Option<&str>, u8, MemStorage) -> Result<Box<dyn SimNode>, String>,
+    build: Build,
     persistent_size: usize,
 }
 

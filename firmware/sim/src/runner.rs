@@ -54,10 +54,7 @@ pub fn spawn(hub: &Hub, nodes: Vec<Box<dyn SimNode>>) -> Running {
     let stop = Arc::new(AtomicBool::new(false));
     let stats = Arc::new(Stats::default());
     let (stop2, stats2) = (stop.clone(), stats.clone());
-    let thread = std::thread::Builder::new()
-        .name("coforge-sim".into())
-        .spawn(move || run(nodes, ports, &stop2, &stats2))
-        .ok();
+    let thread = std::thread::Builder::new().name("coforge-sim".into()).spawn(move || run(nodes, ports, &stop2, &stats2)).ok();
     Running { stop, thread, stats }
 }
 

@@ -1,6 +1,8 @@
 //! The CANopen stack of generated devices on the virtual bus, driven frame by frame the way a
 //! master would: NMT, SDO, PDOs, heartbeat, guarding, EMCY, store/restore.
 
+#![allow(clippy::unwrap_used)]
+
 use coforge_sim::devices::{DeviceKind, SimNode, StoreAt};
 use coforge_sim::vbus::VirtualBus;
 use coforge_stack::frame::CanFrame;

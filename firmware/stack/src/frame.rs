@@ -40,11 +40,7 @@ impl CanFrame {
     /// Converts any `embedded-can` frame; extended identifiers are not CANopen traffic.
     pub fn from_frame(frame: &impl embedded_can::Frame) -> Option<CanFrame> {
         let Id::Standard(id) = frame.id() else { return None };
-        if frame.is_remote_frame() {
-            CanFrame::remote(id.as_raw(), u8::try_from(frame.dlc()).ok()?)
-        } else {
-            CanFrame::data(id.as_raw(), frame.data())
-        }
+        if frame.is_remote_frame() { CanFrame::remote(id.as_raw(), u8::try_from(frame.dlc()).ok()?) } else { CanFrame::data(id.as_raw(), frame.data()) }
     }
 }
 
