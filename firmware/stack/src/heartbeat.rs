@@ -37,7 +37,7 @@ impl Producer {
 }
 
 /// How many producers one node can monitor at once.
-pub const MAX_CONSUMED: usize = 16;
+pub const MAX_CONSUMED: usize = 8;
 
 /// One monitored producer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -140,6 +140,6 @@ mod tests {
         assert!(c.any_lost());
         assert_eq!(c.on_heartbeat(5, 0x7F, 200_000), Some(ConsumerEvent::Recovered(5)));
         assert_eq!(c.monitored()[0].state, Some(NmtState::PreOperational));
-        assert!(!c.configure((0..17).map(|n| (n + 1) << 16 | 100)));
+        assert!(!c.configure((0..9).map(|n| (n + 1) << 16 | 100)));
     }
 }

@@ -76,8 +76,8 @@ pub enum NodeEvent {
     RestartController,
 }
 
-const TX_QUEUE: usize = 24;
-const EVENTS: usize = 8;
+const TX_QUEUE: usize = 16;
+const EVENTS: usize = 4;
 
 /// Everything except the SDO server, which borrows it as its [`crate::sdo::SdoTarget`].
 #[derive(Debug)]
@@ -686,26 +686,41 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
 
     /// SYNC, EMCY, heartbeat, guarding and consumer parameters.
     fn reload_services(&mut self, now_us: u64) {
-        let id = u16::from(self.node_id);
+        self.reload_sync();
+        self.reload_emcy();
+        self.reload_guarding();
+        self.reload_heartbeat(now_us);
+        self.reload_consumer();
+    }
+
+    pub(super) fn reload_sync(&mut self) {
         self.sync_cob = read_u32(&mut self.od, 0x1005, 0).map(|c| (c & 0x7FF) as u16).or(Some(0x080));
+    }
+
+    pub(super) fn reload_emcy(&mut self) {
         self.emcy_cob = match read_u32(&mut self.od, 0x1014, 0) {
             Some(c) if c & crate::pdo::COB_INVALID != 0 => None,
             Some(c) => Some((c & 0x7FF) as u16),
-            None => Some(0x080 + id),
+            None => Some(0x080 + u16::from(self.node_id)),
         };
         self.emcy_inhibit = read_u32(&mut self.od, 0x1015, 0).unwrap_or(0) as u16;
-        self.guard_cob = read_u32(&mut self.od, 0x100E, 0).map_or(0x700 + id, |c| (c & 0x7FF) as u16);
+    }
+
+    pub(super) fn reload_guarding(&mut self) {
+        self.guard_cob = read_u32(&mut self.od, 0x100E, 0).map_or(0x700 + u16::from(self.node_id), |c| (c & 0x7FF) as u16);
         let guard_ms = read_u32(&mut self.od, 0x100C, 0).unwrap_or(0) as u16;
         let factor = read_u32(&mut self.od, 0x100D, 0).unwrap_or(0) as u8;
         self.guarding.configure(guard_ms, factor);
+    }
+
+    pub(super) fn reload_heartbeat(&mut self, now_us: u64) {
         let period = read_u32(&mut self.od, 0x1017, 0).unwrap_or(0) as u16;
         if period != self.heartbeat.period_ms() {
             self.heartbeat.configure(period, now_us);
         }
-        self.reload_consumer();
     }
 
-    fn reload_consumer(&mut self) {
+    pub(super) fn reload_consumer(&mut self) {
         let count = read_u32(&mut self.od, 0x1016, 0).unwrap_or(0).min(127) as u8;
         let od = &mut self.od;
         let entries = (1..=count).map(|sub| read_u32(od, 0x1016, sub).unwrap_or(0));

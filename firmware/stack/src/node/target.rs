@@ -52,7 +52,11 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     pub(super) fn after_write(&mut self, index: u16, sub: u8) {
         let now = self.now_us;
         match index {
-            0x1005 | 0x100C..=0x100E | 0x1014..=0x1017 => self.reload_services(now),
+            0x1005 => self.reload_sync(),
+            0x100C..=0x100E => self.reload_guarding(),
+            0x1014 | 0x1015 => self.reload_emcy(),
+            0x1016 => self.reload_consumer(),
+            0x1017 => self.reload_heartbeat(now),
             _ => {}
         }
         match Dir::of_index(index) {

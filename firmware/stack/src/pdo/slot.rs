@@ -84,8 +84,11 @@ impl Rpdo {
     }
 }
 
+/// An event timer that is off (a plain `u64` keeps each TPDO 8 bytes smaller than `Option`).
+pub const NEVER: u64 = u64::MAX;
+
 /// A transmit PDO.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Tpdo {
     /// 1800h + `offset` is its communication object.
     pub offset: u16,
@@ -95,8 +98,8 @@ pub struct Tpdo {
     pub pending: bool,
     /// No transmission before this time (inhibit time).
     pub inhibit_until_us: u64,
-    /// When the event timer next fires.
-    pub event_due_us: Option<u64>,
+    /// When the event timer next fires ([`NEVER`] if it is off).
+    pub event_due_us: u64,
     /// SYNCs counted towards the next transmission (types 1..=240).
     pub sync_count: u8,
     /// Waiting for the SYNC counter to reach `sync_start`.
@@ -109,7 +112,17 @@ impl Tpdo {
     pub fn load(od: &mut impl ObjectDictionary, offset: u16, now_us: u64) -> Tpdo {
         let index = Dir::Tx.comm_base() + offset;
         let comm = Comm::read(od, index);
-        let mut t = Tpdo { offset, comm, mapping: read_mapping(od, Dir::mapping_of(index), Dir::Tx), ..Tpdo::default() };
+        let mut t = Tpdo {
+            offset,
+            comm,
+            mapping: read_mapping(od, Dir::mapping_of(index), Dir::Tx),
+            pending: false,
+            inhibit_until_us: 0,
+            event_due_us: NEVER,
+            sync_count: 0,
+            waiting_for_start: false,
+            sampled: None,
+        };
         t.restart(now_us);
         t
     }
@@ -121,7 +134,7 @@ impl Tpdo {
         self.sampled = None;
         self.waiting_for_start = self.comm.sync_start != 0;
         self.inhibit_until_us = now_us;
-        self.event_due_us = (self.comm.event_driven() && self.comm.event_timer != 0).then(|| now_us + u64::from(self.comm.event_timer) * 1000);
+        self.event_due_us = if self.comm.event_driven() && self.comm.event_timer != 0 { now_us + u64::from(self.comm.event_timer) * 1000 } else { NEVER };
     }
 
     /// Whether a SYNC with optional `counter` makes this TPDO send (types 0..=240), or
@@ -164,7 +177,7 @@ impl Tpdo {
         if !self.comm.event_driven() {
             return false;
         }
-        if self.event_due_us.is_some_and(|t| now_us >= t) {
+        if now_us >= self.event_due_us {
             self.pending = true;
         }
         self.pending && now_us >= self.inhibit_until_us
@@ -175,7 +188,7 @@ impl Tpdo {
         self.pending = false;
         self.inhibit_until_us = now_us + u64::from(self.comm.inhibit_time) * 100;
         if self.comm.event_driven() && self.comm.event_timer != 0 {
-            self.event_due_us = Some(now_us + u64::from(self.comm.event_timer) * 1000);
+            self.event_due_us = now_us + u64::from(self.comm.event_timer) * 1000;
         }
     }
 }
