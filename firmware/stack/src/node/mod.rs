@@ -430,6 +430,8 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             self.raise_event(EmcyEvent::RpdoLength);
             return;
         }
+        // A PDO of the right length ends the length error.
+        self.clear_event(EmcyEvent::RpdoLength);
         if r.comm.synchronous() {
             let mut buf = [0_u8; 8];
             let n = data.len().min(8);
@@ -533,9 +535,14 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
                 self.event(NodeEvent::RestartController);
             }
         }
+        self.send_emcy();
+    }
+
+    /// The next queued emergency, if the state and the inhibit time allow it now.
+    fn send_emcy(&mut self) {
         if nmt::allows_emcy_and_sync(self.state)
             && let Some(cob) = self.emcy_cob
-            && let Some(frame) = self.emcy.next(now_us, self.emcy_inhibit)
+            && let Some(frame) = self.emcy.next(self.now_us, self.emcy_inhibit)
         {
             self.send(cob, &frame);
         }
@@ -601,6 +608,8 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         if let Some(entry) = change.history {
             self.push_history(entry);
         }
+        // Sent before the reaction: an error that stops the node must still be reported.
+        self.send_emcy();
         self.react(e.reaction, communication);
     }
 
