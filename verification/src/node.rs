@@ -149,8 +149,9 @@ fn drive(node: &mut impl Driven, entries: &[EntryInfo], input: &[u8]) {
         let (step, frame) = frame_of(chunk);
         now += step;
         if let Some(f) = frame {
-            // A block upload continues only with block-upload client frames (ccs 5).
-            if f.id == 0x600 + u16::from(NODE_ID) && f.data[0] >> 5 != 5 {
+            // A block upload continues only with block-upload client frames (ccs 5); the
+            // server ignores remote frames.
+            if f.id == 0x600 + u16::from(NODE_ID) && !f.rtr && f.data[0] >> 5 != 5 {
                 block_upload = false;
             }
             node.on_frame(&f, now);

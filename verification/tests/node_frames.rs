@@ -45,3 +45,10 @@ fn every_sdo_phase_under_garbage() {
         }
     }
 }
+
+#[test]
+fn fuzz_regression_remote_frame_during_block_upload() {
+    // Found by the fuzzer: the checker, not the node, took a remote frame on the SDO
+    // identifier for a client request that ends a block upload.
+    prop_node_frames(include_bytes!("../fuzz/corpus/node_frames/regression_rtr_during_block_upload"));
+}

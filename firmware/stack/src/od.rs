@@ -239,6 +239,14 @@ impl EntryInfo {
     }
 
     fn check_value(&self, data: &[u8]) -> Result<(), SdoAbort> {
+        // Fast path for the common entry without limits: a value of the right length always
+        // fits its integer type, except a BOOLEAN byte holding 2..255.
+        if self.limits.is_none() {
+            return match (self.data_type, data) {
+                (DataType::Boolean, [b]) if *b > 1 => Err(SdoAbort::ValueTooHigh),
+                _ => Ok(()),
+            };
+        }
         let Some(value) = decode_int(self.data_type, data) else { return Ok(()) };
         // Only BOOLEAN can carry bits its type does not allow (a byte holding 2..255).
         if self.data_type.int_range().is_some_and(|(_, hi)| value > hi) {

@@ -18,6 +18,11 @@ macro_rules! integer_value {
                 read_slice(bytes.get(..usize::from(entry.size)).unwrap_or(&bytes), offset, buf)
             }
             fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
+                // Full-width values (all but the 24/40/48/56-bit types) need no sign extension.
+                if let Ok(bytes) = data.try_into() {
+                    *self = <$t>::from_le_bytes(bytes);
+                    return Ok(());
+                }
                 let value = decode_int(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)?;
                 *self = <$t>::try_from(value).map_err(|_| SdoAbort::ValueTooHigh)?;
                 Ok(())

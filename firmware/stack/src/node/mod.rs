@@ -105,6 +105,8 @@ pub struct Core<D, S, const P: usize> {
     guard_cob: u16,
     rpdos: Vec<Rpdo, P>,
     tpdos: Vec<Tpdo, P>,
+    /// A Bloom filter of the objects valid TPDOs map: most writes skip the TPDO scan.
+    tpdo_mapped: u64,
     bus: BusState,
     bus_off_since: Option<u64>,
 }
@@ -144,6 +146,7 @@ impl<D: Dictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N,
             guard_cob: 0,
             rpdos: Vec::new(),
             tpdos: Vec::new(),
+            tpdo_mapped: 0,
             bus: BusState::Active,
             bus_off_since: None,
         };
@@ -691,6 +694,17 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
                 let _ = self.tpdos.push(t);
             }
         }
+        self.refresh_tpdo_filter();
+    }
+
+    /// The filter bit of one object; a set bit means "maybe mapped".
+    pub(super) const fn filter_bit(index: u16, sub: u8) -> u64 {
+        1 << ((index ^ index >> 6 ^ (sub as u16).wrapping_mul(7)) & 63)
+    }
+
+    pub(super) fn refresh_tpdo_filter(&mut self) {
+        self.tpdo_mapped =
+            self.tpdos.iter().filter(|t| t.comm.valid()).flat_map(|t| t.mapping.entries()).fold(0, |acc, m| acc | Self::filter_bit(m.index, m.sub));
     }
 
     /// SYNC, EMCY, heartbeat, guarding and consumer parameters.

@@ -71,8 +71,10 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
                     if let Some(slot) = self.tpdos.get_mut(i) {
                         *slot = t;
                     }
+                    self.refresh_tpdo_filter();
                 }
             }
+            None if self.tpdo_mapped & Self::filter_bit(index, sub) == 0 => {}
             None => {
                 for t in &mut self.tpdos {
                     if t.comm.valid() && t.mapping.contains(index, sub) {
