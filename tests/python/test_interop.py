@@ -14,6 +14,7 @@ Timing: the simulator runs in real time and frames travel over TCP, so every wai
 timeout and periods are checked with generous tolerances.
 """
 
+import binascii
 import json
 import os
 import pathlib
@@ -199,19 +200,20 @@ class Device:
     def nmt(self, command):
         self.node.nmt.send_command(command)
 
-    def guard(self, timeout=1.0):
+    def guard(self, timeout=1.0, node_id=None):
         """One node guarding request (RTR on 700h + node-ID); the answer frame."""
+        cob = 0x700 + (node_id or self.node_id)
         mark = self.rec.mark()
-        self.net.send_message(self.nmt_err_cob, b"", remote=True)
+        self.net.send_message(cob, b"", remote=True)
         # A boot-up message (state 0) is never a guarding answer: it may still be on its way if
         # the node started after the master connected.
-        f = self.rec.wait(self.nmt_err_cob, mark, timeout, lambda f: f.data != b"\x00")
+        f = self.rec.wait(cob, mark, timeout, lambda f: f.data != b"\x00")
         assert f is not None, "no answer to the node guarding request"
         assert len(f.data) == 1, f"guarding answer {f}"
         return f
 
-    def guarded_state(self):
-        return self.guard().data[0] & 0x7F
+    def guarded_state(self, node_id=None):
+        return self.guard(node_id=node_id).data[0] & 0x7F
 
     def wait_heartbeat(self, state, timeout=1.0, mark=None):
         mark = self.rec.mark() if mark is None else mark
@@ -250,10 +252,12 @@ def _banner(proc, timeout=20.0):
 
 @pytest.fixture
 def start(eds_file):
-    """start(device, mode=None, node_id=None, store=None) -> Device; all stopped at teardown."""
+    """start(device, mode=None, node_id=None, store=None, nodes=1) -> Device, with python-canopen
+    connected; start.stop(dev) ends one early. Teardown stops the rest and fails the test if a
+    simulator died on its own (a panic), showing its stderr."""
     running = []
 
-    def _start(name, mode=None, node_id=None, store=None):
+    def _start(name, mode=None, node_id=None, store=None, nodes=1):
         node_id = NODE_ID[name] if node_id is None else node_id
         mode = mode or default_mode(name)
         args = [COFORGE, "sim", name, "--node-id", str(node_id), "--port", "0"]
@@ -261,6 +265,8 @@ def start(eds_file):
             args += ["--mode", mode]
         if store:
             args += ["--store", str(store)]
+        if nodes != 1:
+            args += ["--nodes", str(nodes)]
         err = tempfile.TemporaryFile()
         proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=err, text=True)
         try:
@@ -272,16 +278,26 @@ def start(eds_file):
             raise RuntimeError(f"coforge sim failed: {err.read().decode(errors='replace')}") from None
         net = canopen.Network()
         net.NOTIFIER_CYCLE = 0.05  # a short receive cycle makes disconnect fast
-        net.connect(interface="slcan", channel=url, sleep_after_open=0, bitrate=500000)
+        # The recorder sees each frame before python-canopen does, so a frame that completed an
+        # SDO transfer is recorded by the time the transfer returns.
         rec = Recorder()
-        net.notifier.add_listener(rec)
+        net.listeners.insert(0, rec)
+        try:
+            net.connect(interface="slcan", channel=url, sleep_after_open=0, bitrate=500000)
+        except Exception:
+            proc.kill()
+            proc.wait()
+            raise
         node = canopen.RemoteNode(node_id, str(eds_file(name, mode)))
         net.add_node(node)
+        for other in range(node_id + 1, node_id + nodes):
+            net.add_node(canopen.RemoteNode(other, str(eds_file(name, mode))))
         dev = Device(name, mode, node_id, proc, net, node, rec, err)
         running.append(dev)
         return dev
 
     def _stop(dev):
+        exited = dev.proc.poll()
         try:
             # pyserial's socket:// close() sleeps 0.3 s "in case of quick reconnects"; every test
             # has its own hub, so that pause only slows the suite down.
@@ -292,13 +308,21 @@ def start(eds_file):
             dev.proc.kill()
             dev.proc.wait(timeout=10)
             dev.proc.stdout.close()
+            dev.stderr.seek(0)
+            stderr = dev.stderr.read().decode(errors="replace")
             dev.stderr.close()
             running.remove(dev)
+        assert exited is None, f"coforge sim {dev.name} exited by itself with {exited}: {stderr}"
 
     _start.stop = _stop
     yield _start
+    failures = []
     for dev in list(running):
-        _stop(dev)
+        try:
+            _stop(dev)
+        except AssertionError as e:
+            failures.append(str(e))
+    assert not failures, "; ".join(failures)
 
 
 def sdo_abort(fn, *args, **kw):
@@ -321,7 +345,6 @@ def test_bootup_after_nmt_reset(start, name, command):
     assert dev.guarded_state() == OPERATIONAL
     mark = dev.rec.mark()
     dev.nmt(command)
-    # python-canopen's own view: INITIALISING until the boot-up message arrives.
     boot = dev.rec.wait(dev.nmt_err_cob, mark, 2.0)
     assert boot is not None, "no boot-up message after the reset"
     assert boot.data == bytes([BOOT]), f"boot-up message must carry one byte 0: {boot}"
@@ -359,10 +382,13 @@ def test_reset_communication_keeps_application_values_reset_node_does_not(start)
     dev = start("co401gw1")
     dev.write_int(0x6200, 1, 0x5A, 1)  # application (device profile) area, RAM
     dev.write_int(0x100C, 0, 321, 2)  # communication area
+    remap_tpdo(dev, 1, [(0x6411, 1, 16)], 1, event_timer=500)
     mark = dev.rec.mark()
     dev.nmt(RESET_COMM)
     assert dev.rec.wait(dev.nmt_err_cob, mark, 2.0) is not None
     assert dev.read_int(0x100C) == 0, "reset communication restores the communication area"
+    assert (dev.read_int(0x1800, 2), dev.read_int(0x1800, 5)) == (255, 1000), "TPDO parameters restored"
+    assert [dev.read_int(0x1A00, s) for s in range(9)] == [8] + [0x60000008 | s << 8 for s in range(1, 9)], "mapping restored"
     assert dev.read_int(0x6200, 1) == 0x5A, "reset communication must not touch 6000h..9FFFh"
     mark = dev.rec.mark()
     dev.nmt(RESET_NODE)
@@ -418,6 +444,13 @@ def test_nmt_states_through_node_guarding(start, name):
     assert dev.rec.wait(dev.nmt_err_cob, mark, 2.0, lambda f: f.data == b"\x00") is not None
     assert dev.guard().data[0] == PRE_OPERATIONAL
     assert dev.guard().data[0] == 0x80 | PRE_OPERATIONAL
+    # Reset node works from Stopped too.
+    dev.nmt(STOP)
+    assert dev.guarded_state() == STOPPED
+    mark = dev.rec.mark()
+    dev.nmt(RESET_NODE)
+    assert dev.rec.wait(dev.nmt_err_cob, mark, 2.0, lambda f: f.data == b"\x00") is not None, "no boot-up after reset node in Stopped"
+    assert dev.guard().data[0] == PRE_OPERATIONAL
 
 
 def test_node_guarding_by_python_canopen(start):
@@ -442,7 +475,7 @@ def test_node_guarding_by_python_canopen(start):
 # ============================================================================================
 
 
-@pytest.mark.parametrize("name,rw", [("co401gw1", (0x100C, 0, 2)), ("cr3101", (0x100C, 0, 2)), ("canopenia", (0x1017, 0, 2))])
+@pytest.mark.parametrize("name,rw", [("co401gw1", (0x100C, 0, 2)), ("cr3101", (0x100C, 0, 2)), ("canopenia", (0x1017, 0, 2))], ids=["co401gw1", "cr3101", "canopenia"])
 def test_sdo_expedited(start, name, rw):
     dev = start(name)
     # Read: values from the EDS/spec defaults.
@@ -461,6 +494,19 @@ def test_sdo_expedited(start, name, rw):
     assert resp.data[:4] == bytes([0x60, index & 0xFF, index >> 8, sub]), f"download response {resp}"
     assert dev.read_int(index, sub) == 0x1234
     assert dev.node.sdo[index].raw == 0x1234
+
+
+@pytest.mark.parametrize("name,index", [("co401gw1", 0x1017), ("cr3101", 0x100C)], ids=["co401gw1-1017", "cr3101-100C"])
+def test_sdo_expedited_download_without_size(start, name, index):
+    """CiA 301 7.2.4.3.3: e = 1, s = 0 means "d contains an unspecified number of bytes"; the
+    server takes the bytes its object needs (here 2 of the 4). Some masters send this form."""
+    dev = start(name)
+    mark = dev.rec.mark()
+    dev.net.send_message(0x600 + dev.node_id, bytes([0x22, index & 0xFF, index >> 8, 0, 0x34, 0x12, 0x00, 0x00]))
+    resp = dev.rec.wait(dev.sdo_tx_cob, mark, 1.0)
+    assert resp is not None
+    assert resp.data[:4] == bytes([0x60, index & 0xFF, index >> 8, 0]), f"download response expected, got {resp}"
+    assert dev.read_int(index) == 0x1234
 
 
 @pytest.mark.parametrize("name", ["co401gw1", "cr3101", "canopenia"])
@@ -489,6 +535,7 @@ def test_sdo_segmented_upload(start, name):
         # the INTEGER32 6424h sub 1 (analog input upper limit) exercises the protocol.
         ("co401gw1", 0x6424, 1, (-123456).to_bytes(4, "little", signed=True)),
     ],
+    ids=["cr3101-2000-string11", "cr3101-3000.1-string8", "co401gw1-6424.1-int32"],
 )
 def test_sdo_segmented_download(start, name, index, sub, data):
     dev = start(name)
@@ -526,12 +573,13 @@ def test_sdo_block_upload(start, name):
 @pytest.mark.parametrize(
     "name,index,sub,data",
     [
-        # An 11-byte VISIBLE_STRING (cr3101 2000h): two block segments, CRC over all 11 bytes.
+        # An 11-byte VISIBLE_STRING (cr3101 2000h): two segments, CRC over all 11 bytes.
         ("cr3101", 0x2000, 0, b"BLOCKXFER11"),
         # co401gw1 has no writable entry of 8 bytes or more: a 4-byte INTEGER32 (6424h sub 1)
         # still exercises initiate, one segment, end with CRC.
         ("co401gw1", 0x6424, 1, (0x12345678).to_bytes(4, "little")),
     ],
+    ids=["cr3101-2000-string11", "co401gw1-6424.1-int32"],
 )
 def test_sdo_block_download_and_upload(start, name, index, sub, data):
     dev = start(name)
@@ -564,6 +612,10 @@ ABORT_CASES = [
     ("co401gw1", DOWN, 0x1017, 0, b"\x01\x00\x00\x00", 0x06070012, "length too high"),
     ("co401gw1", DOWN, 0x1029, 1, b"\x03", 0x06090031, "value too high"),
     ("co401gw1", DOWN, 0x1800, 2, bytes([241]), 0x06090030, "reserved transmission type"),
+    ("co401gw1", DOWN, 0x1800, 1, (0x1FE).to_bytes(4, "little"), 0x06090030, "PDO COB-ID change while valid"),
+    ("co401gw1", DOWN, 0x1014, 0, (0x0FE).to_bytes(4, "little"), 0x06090030, "EMCY COB-ID change while valid"),
+    ("co401gw1", DOWN, 0x1800, 3, (10).to_bytes(2, "little"), 0x06090030, "inhibit time change while valid"),
+    ("co401gw1", DOWN, 0x1400, 2, bytes([253]), 0x06090030, "RTR-only transmission type for an RPDO"),
     ("cr3101", DOWN, 0x1000, 0, b"\x00\x00\x00\x00", 0x06010002, "read-only object"),
     ("cr3101", UP, 0x2222, 0, None, 0x06020000, "missing object"),
     ("cr3101", UP, 0x1018, 4, None, 0x06090011, "missing sub-index"),
@@ -572,6 +624,7 @@ ABORT_CASES = [
     ("cr3101", DOWN, 0x20F0, 0, bytes([128]), 0x06090031, "value too high"),
     ("cr3101", DOWN, 0x20F0, 0, bytes([0]), 0x06090032, "value too low"),
     ("cr3101", DOWN, 0x3003, 1, bytes([4]), 0x06090030, "value not in the allowed list"),
+    ("cr3101", DOWN, 0x1404, 1, (0x100 + 0x22).to_bytes(4, "little"), 0x06090030, "restricted COB-ID"),
     ("canopenia", UP, 0x5F01, 1, None, 0x06010001, "write-only object"),
     ("canopenia", DOWN, 0x1008, 0, b"X", 0x06010002, "const object"),
     ("canopenia", DOWN, 0x1F51, 1, bytes([4]), 0x06090031, "value too high"),
@@ -598,6 +651,70 @@ def test_sdo_abort_codes(start, name, direction, index, sub, data, code):
     assert int.from_bytes(abort.data[4:], "little") == code
     if before is not None:
         assert dev.read(index, sub) == before, "a refused write leaves the value unchanged"
+
+
+def test_sdo_protocol_errors(start):
+    """Raw SDO frames: unknown command specifier, toggle error, block CRC error."""
+    dev = start("cr3101")
+    rx, tx = 0x600 + dev.node_id, dev.sdo_tx_cob
+
+    def request(payload, timeout=1.0):
+        mark = dev.rec.mark()
+        dev.net.send_message(rx, bytes(payload).ljust(8, b"\x00"))
+        f = dev.rec.wait(tx, mark, timeout)
+        assert f is not None, f"no SDO response to {bytes(payload).hex(' ')}"
+        return f.data
+
+    def abort_code(data):
+        assert data[0] == 0x80, f"abort expected: {data.hex(' ')}"
+        return int.from_bytes(data[4:8], "little")
+
+    before = dev.read(0x2000)
+    # Client command specifier 7 does not exist: 0504 0001h.
+    assert abort_code(request([0xE0, 0x00, 0x20, 0x00])) == 0x05040001
+    # Segmented download whose first segment has toggle bit 1: 0503 0000h.
+    assert request([0x21, 0x00, 0x20, 0x00, 11, 0, 0, 0])[:4] == bytes([0x60, 0x00, 0x20, 0x00])
+    assert abort_code(request([0x10, *b"TOGGLE!"])) == 0x05030000
+    # Block download with a wrong CRC: 0504 0004h.
+    data = b"CRC-ERROR!!"
+    resp = request([0xC6, 0x00, 0x20, 0x00, len(data), 0, 0, 0])
+    assert resp[:4] == bytes([0xA4, 0x00, 0x20, 0x00]), f"block download with CRC support expected: {resp.hex(' ')}"
+    blksize = resp[4]
+    assert 1 <= blksize <= 127, "block size"
+    segments = [data[i : i + 7] for i in range(0, len(data), 7)]
+    while segments:
+        block, segments = segments[:blksize], segments[blksize:]
+        mark = dev.rec.mark()
+        for seqno, seg in enumerate(block, 1):
+            last = 0x80 if not segments and seqno == len(block) else 0
+            dev.net.send_message(rx, bytes([last | seqno, *seg.ljust(7, b"\x00")]))
+        ack = dev.rec.wait(tx, mark, 1.0)
+        assert ack is not None and ack.data[:2] == bytes([0xA2, len(block)]), f"block acknowledge {ack}"
+        blksize = ack.data[2]
+    crc = binascii.crc_hqx(data, 0) ^ 0xFFFF
+    assert abort_code(request([0xC1 | 3 << 2, crc & 0xFF, crc >> 8])) == 0x05040004
+    assert dev.read(0x2000) == before, "aborted transfers leave the value unchanged"
+    # Segmented download without size indication (e = 0, s = 0): the last segment ends it.
+    assert request([0x20, 0x00, 0x20, 0x00])[:4] == bytes([0x60, 0x00, 0x20, 0x00])
+    assert request([0x00, *b"NO-SIZE"])[0] == 0x20
+    assert request([0x10 | 4 << 1 | 1, *b"!!!", 0, 0, 0, 0])[0] == 0x30  # n = 4: 3 data bytes
+    assert dev.read(0x2000) == b"NO-SIZE!!!"
+    # A transfer the client aborts is dropped silently; the next one starts afresh.
+    assert request([0x21, 0x00, 0x20, 0x00, 11, 0, 0, 0])[0] == 0x60
+    mark = dev.rec.mark()
+    dev.net.send_message(rx, bytes([0x80, 0x00, 0x20, 0x00, 0x00, 0x00, 0x04, 0x05]))
+    assert dev.rec.wait(tx, mark, 0.1) is None, "a server must not answer an abort"
+    assert request([0x00, *b"IGNORED"])[:1] == b"\x80", "a segment after the abort is no transfer"
+    assert dev.read(0x2000) == b"NO-SIZE!!!"
+    # A transfer the client abandons is aborted by the server's timeout: 0504 0000h.
+    assert request([0x21, 0x00, 0x20, 0x00, 11, 0, 0, 0])[0] == 0x60
+    mark = dev.rec.mark()
+    timeout = dev.rec.wait(tx, mark, 3.0)
+    assert timeout is not None, "no abort after the client stopped sending segments"
+    assert abort_code(timeout.data) == 0x05040000
+    # The server is ready for the next transfer.
+    dev.write(0x2000, 0, b"AFTER")
+    assert dev.read(0x2000) == b"AFTER"
 
 
 # ============================================================================================
@@ -724,7 +841,7 @@ def test_tpdo_synchronous(start, name, trans_type):
     sent_after = []
     for i in range(1, 7):
         mark = dev.rec.mark()
-        dev.net.sync.transmit()
+        dev.net.sync.transmit(i if i > 3 else None)  # SYNC without, then with the counter byte
         f = dev.rec.wait(cob, mark, 0.5 if i % trans_type == 0 else 0.1)
         if f is not None:
             sent_after.append(i)
@@ -746,6 +863,11 @@ def test_tpdo_event_timer_and_inhibit_time(start):
     assert 7 <= len(frames) <= 13, f"{len(frames)} TPDOs in 1 s with a 100 ms event timer"
     gaps = [b.t - a.t for a, b in zip(frames, frames[1:])]
     assert 0.07 <= statistics.median(gaps) <= 0.13, f"event timer gaps {gaps}"
+    # Leaving Operational stops the PDO.
+    dev.nmt(PRE_OP)
+    assert dev.guarded_state() == PRE_OPERATIONAL
+    mark = dev.rec.mark()
+    assert dev.rec.wait(pdo.cob_id, mark, 0.25) is None, "TPDO sent in pre-operational"
 
     # Inhibit time 50 ms (500 x 100 us), event timer off: a burst of events is spaced out and
     # the last value still goes out.
@@ -765,6 +887,28 @@ def test_tpdo_event_timer_and_inhibit_time(start):
     assert all(g >= 0.04 for g in gaps), f"TPDOs closer than the 50 ms inhibit time: {gaps}"
 
 
+def test_tpdo_synchronous_rtr(start):
+    """Transmission type 252: the data is sampled at SYNC and sent on a remote frame."""
+    dev = start("co401gw1")
+    entries = [(0x6411, 1, 16)]
+    pdo = remap_tpdo(dev, 1, entries, 252)
+    dev.nmt(START)
+    dev.write_int(0x6411, 1, 1111, 2)
+    dev.net.sync.transmit()
+    dev.write_int(0x6411, 1, 2222, 2)
+    mark = dev.rec.mark()
+    assert dev.rec.wait(pdo.cob_id, mark, 0.15) is None, "type 252 sends only on a remote request"
+    dev.net.send_message(pdo.cob_id, b"", remote=True)
+    f = dev.rec.wait(pdo.cob_id, mark, 1.0)
+    assert f is not None, "no TPDO answering the remote request"
+    assert f.data == (1111).to_bytes(2, "little"), "the value sampled at the SYNC, not the current one"
+    dev.net.sync.transmit()
+    mark = dev.rec.mark()
+    dev.net.send_message(pdo.cob_id, b"", remote=True)
+    f = dev.rec.wait(pdo.cob_id, mark, 1.0)
+    assert f is not None and f.data == (2222).to_bytes(2, "little")
+
+
 def test_tpdo_remote_request(start):
     """Transmission type 253: sent on a remote frame (RTR allowed in the COB-ID)."""
     dev = start("co401gw1")
@@ -780,6 +924,15 @@ def test_tpdo_remote_request(start):
     f = dev.rec.wait(pdo.cob_id, mark, 1.0)
     assert f is not None, "no TPDO answering the remote request"
     assert f.data == packed(entries, [dev.read_int(0x6200, 1), 7, -2])
+    # COB-ID bit 30 set: remote requests are not answered.
+    dev.nmt(PRE_OP)
+    pdo.rtr_allowed = False
+    pdo.save()
+    assert dev.read_int(0x1800, 1) & 0xC0000000 == 0x40000000
+    dev.nmt(START)
+    mark = dev.rec.mark()
+    dev.net.send_message(pdo.cob_id, b"", remote=True)
+    assert dev.rec.wait(pdo.cob_id, mark, 0.2) is None, "TPDO answered a remote request with RTR not allowed"
 
 
 def test_pdo_mapping_rules(start):
@@ -890,6 +1043,10 @@ def test_rpdo_remap_by_master(start):
     assert dev.read_int(0x6200, 8) == 0x88
     assert dev.read_int(0x6200, 7) == 0x77
     assert dev.read_int(0x6200, 1) == 0
+    # CiA 301: of an RPDO longer than its mapping the first bytes are used.
+    dev.net.send_message(rpdo.cob_id, bytes([0x18, 0x17, 1, 2, 3, 4, 5, 6]))
+    assert (dev.read_int(0x6200, 8), dev.read_int(0x6200, 7)) == (0x18, 0x17)
+    assert [dev.read_int(0x6200, s) for s in range(1, 7)] == [0] * 6
 
 
 # ============================================================================================
@@ -966,6 +1123,9 @@ def test_life_guarding_emcy(start, name):
     # python-canopen's EMCY consumer decoded it.
     assert any(e.code == 0x8130 and e.register == payload[2] for e in dev.node.emcy.log)
     assert dev.node.sdo[0x1001].raw == payload[2], "1001h mirrors the active error"
+    if dev.has(0x1003):
+        assert dev.read_int(0x1003, 0) == 1, "1003h counts the error"
+        assert dev.read_int(0x1003, 1) & 0xFFFF == 0x8130, "1003h sub 1 holds the newest error code"
     # The next guarding request shows the 1029h reaction and ends the error: error reset EMCY.
     mark = dev.rec.mark()
     assert dev.guard().data[0] & 0x7F == state_after
@@ -990,19 +1150,18 @@ def test_guarding_warning_emcy(start):
     assert dev.guarded_state() == OPERATIONAL, "the warning changes no NMT state"
 
 
-@pytest.mark.parametrize(
-    "name,number,length",
-    [("co401gw1", 1, 8), ("cr3101", 1, 8), ("canopenia", 1, 8)],
-)
-def test_rpdo_too_short_emcy(start, name, number, length):
+@pytest.mark.parametrize("name", ["co401gw1", "cr3101", "canopenia"])
+def test_rpdo_too_short_emcy(start, name):
     dev = start(name)
-    cob = dev.read_int(0x1400 + number - 1, 1) & 0x7FF
-    mapped = [dev.read_int(0x1600 + number - 1, s) for s in range(1, dev.read_int(0x1600 + number - 1, 0) + 1)]
+    cob = dev.read_int(0x1400, 1) & 0x7FF
+    mapped = [dev.read_int(0x1600, s) for s in range(1, dev.read_int(0x1600, 0) + 1)]
     first = (mapped[0] >> 16, mapped[0] >> 8 & 0xFF)
+    length = sum(m & 0xFF for m in mapped) // 8
+    assert length > 3
     dev.nmt(START)
     before = dev.read(*first)
     mark = dev.rec.mark()
-    dev.net.send_message(cob, bytes([0x5A] * (length - 5)))
+    dev.net.send_message(cob, bytes([0x5A] * 3))
     emcy = dev.wait_emcy(mark, 0x8210, 1.0)
     assert emcy is not None, "no EMCY 8210h for an RPDO shorter than its mapping"
     assert emcy.data[2] == 0x11, f"error register {emcy}"
@@ -1060,6 +1219,61 @@ def test_heartbeat_consumer_timeout_emcy(start, behaviour, state_after):
     assert dev.node.sdo[0x1001].raw == 0
 
 
+def test_emcy_inhibit_time_and_cob_id(start):
+    dev = start("co401gw1")
+    dev.write_int(0x1015, 0, 1000, 2)  # 100 ms between EMCYs
+    dev.nmt(START)
+    cob = 0x200 + dev.node_id
+    mark = dev.rec.mark()
+    dev.net.send_message(cob, b"\x01")  # too short: 8210h
+    dev.net.send_message(cob, bytes(8))  # correct: error reset
+    raised = dev.wait_emcy(mark, 0x8210, 1.0)
+    reset = dev.wait_emcy(mark, 0x0000, 1.0)
+    assert raised is not None and reset is not None
+    assert reset.t - raised.t >= 0.08, f"EMCYs {reset.t - raised.t:.3f} s apart, inhibit time 100 ms"
+    # A new EMCY COB-ID: invalidate, then set the new identifier.
+    dev.write_int(0x1014, 0, 0x80000000 | 0x85, 4)
+    dev.write_int(0x1014, 0, 0x0FE, 4)
+    mark = dev.rec.mark()
+    dev.net.send_message(cob, b"\x01")
+    f = dev.rec.wait(0x0FE, mark, 1.0)
+    assert f is not None and f.data[:3] == bytes([0x10, 0x82, 0x11]), f"EMCY on the new COB-ID: {f}"
+    assert dev.rec.since(mark, dev.emcy_cob) == []
+
+
+def test_heartbeat_consumer_rejects_duplicate_producer(start):
+    dev = start("canopenia")
+    dev.write_int(0x1016, 1, 0x33 << 16 | 100, 4)
+    assert sdo_abort(dev.write_int, 0x1016, 2, 0x33 << 16 | 200, 4) == 0x06040043
+    dev.write_int(0x1016, 2, 0x34 << 16 | 200, 4)
+    assert dev.read_int(0x1016, 2) == 0x34 << 16 | 200
+
+
+def test_broadcast_nmt_with_several_nodes(start):
+    dev = start("co401gw1", nodes=3)
+    ids = [dev.node_id, dev.node_id + 1, dev.node_id + 2]
+    assert [dev.guarded_state(n) for n in ids] == [PRE_OPERATIONAL] * 3
+    dev.net.nmt.send_command(START)  # node-ID 0: every node
+    assert [dev.guarded_state(n) for n in ids] == [OPERATIONAL] * 3
+    dev.net[ids[1]].nmt.send_command(STOP)
+    assert [dev.guarded_state(n) for n in ids] == [OPERATIONAL, STOPPED, OPERATIONAL]
+    # SDO reaches only the addressed node.
+    mark = dev.rec.mark()
+    assert dev.net[ids[2]].sdo[0x1008].raw == "CO401GW1"
+    sdo_cobs = {f.id for f in dev.rec.since(mark) if 0x580 <= f.id <= 0x5FF}
+    assert sdo_cobs == {0x580 + ids[2]}
+    mark = dev.rec.mark()
+    dev.net.nmt.send_command(RESET_COMM)
+    deadline = time.monotonic() + 2
+    while time.monotonic() < deadline:
+        boots = {f.id for f in dev.rec.since(mark) if f.data == b"\x00" and 0x700 < f.id < 0x780}
+        if len(boots) == 3:
+            break
+        time.sleep(0.01)
+    assert boots == {0x700 + n for n in ids}, "one boot-up message per node"
+    assert [dev.guarded_state(n) for n in ids] == [PRE_OPERATIONAL] * 3
+
+
 # ============================================================================================
 # 8. Store and restore (1010h / 1011h)
 # ============================================================================================
@@ -1087,7 +1301,7 @@ def test_store_and_restore_parameters(start, name):
     capability = dev.read_int(0x1010, 1)
     assert capability & 0x03, f"1010h sub 1 = {capability:#x}"
     dev.write_int(index, sub, stored, size)
-    dev.write_int(0x1010, 1, SAVE, 4)
+    dev.node.store()  # python-canopen: 1010h sub 1 = "save"
     reset_node(dev)
     assert dev.read_int(index, sub) == stored, "stored value lost at reset node"
     # A later change without "save" is lost at reset unless the device saves by itself.
@@ -1096,7 +1310,7 @@ def test_store_and_restore_parameters(start, name):
     after = dev.read_int(index, sub)
     assert after == (changed if capability & 0x02 else stored)
     # Restore defaults: valid after the next reset.
-    dev.write_int(0x1011, 1, LOAD, 4)
+    dev.node.restore()  # 1011h sub 1 = "load"
     assert dev.read_int(index, sub) == after, "restored defaults take effect at the next reset"
     reset_node(dev)
     assert dev.read_int(index, sub) == default
@@ -1129,6 +1343,10 @@ def test_stored_parameters_survive_a_restart(start, tmp_path):
     dev = start("co401gw1", store=store)
     dev.node.sdo[0x1017].raw = 40
     remap_tpdo(dev, 1, [(0x6411, 1, 16)], 255)
+    # Storing to a file takes the simulator about 0.2 s (the file is rewritten for every entry),
+    # close to python-canopen's default SDO timeout of 0.3 s; real devices storing to flash are
+    # slower still, so the master waits longer for this confirmation.
+    dev.node.sdo.RESPONSE_TIMEOUT = 3.0
     dev.write_int(0x1010, 1, SAVE, 4)
     start.stop(dev)
     assert store.exists()

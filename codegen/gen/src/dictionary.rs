@@ -321,25 +321,22 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
         }
 
         impl<A: #stack::od::AppObjects> #stack::od::ObjectDictionary for Od<A> {
-            fn entry(&self, index: u16, sub: u8) -> Result<&#stack::od::EntryInfo, #stack::od::SdoAbort> {
-                #stack::od::find(od::entries(self.mode), index, sub)
+            fn entries(&self) -> &'static [#stack::od::EntryInfo] {
+                od::entries(self.mode)
             }
 
-            fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8], side: #stack::od::Side) -> Result<#stack::od::ReadLen, #stack::od::SdoAbort> {
+            fn read_entry(&mut self, info: &#stack::od::EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<#stack::od::ReadLen, #stack::od::SdoAbort> {
                 use #stack::value::OdValue as _;
-                let info = #stack::od::find(od::entries(self.mode), index, sub)?;
-                info.check_read(side)?;
-                match (index, sub) {
+                match (info.index, sub) {
                     #(#read_arms,)*
                     _ => Err(#stack::od::SdoAbort::NoObject),
                 }
             }
 
-            fn write(&mut self, index: u16, sub: u8, data: &[u8], side: #stack::od::Side, ctx: &#stack::od::AccessContext) -> Result<(), #stack::od::SdoAbort> {
+            fn write_entry(&mut self, info: &#stack::od::EntryInfo, sub: u8, data: &[u8]) -> Result<(), #stack::od::SdoAbort> {
                 use #stack::value::OdValue as _;
-                let info = #stack::od::find(od::entries(self.mode), index, sub)?;
-                info.check_write(side, ctx, data)?;
-                match (index, sub) {
+                info.check_data(data)?;
+                match (info.index, sub) {
                     #(#write_arms,)*
                     _ => Err(#stack::od::SdoAbort::NoObject),
                 }

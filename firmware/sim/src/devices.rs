@@ -144,7 +144,7 @@ impl DeviceKind {
         let capacity = HEADER + self.persistent_size;
         let storage = match store {
             StoreAt::Memory => MemStorage::new(capacity),
-            StoreAt::File(path) => MemStorage::with_file(capacity, path.clone()).map_err(|e| format!("{}: {e}", path.display()))?,
+            StoreAt::File(path) => MemStorage::with_file(capacity, path).map_err(|e| format!("{}: {e}", path.display()))?,
         };
         (self.build)(mode, node_id, storage)
     }

@@ -2,7 +2,9 @@
 //! to a file so stored parameters survive restarting the simulator.
 
 use embedded_storage::{ReadStorage, Storage};
-use std::path::PathBuf;
+use std::fs::File;
+use std::io::{Seek, SeekFrom, Write};
+use std::path::Path;
 
 /// Why a storage access failed.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -12,10 +14,11 @@ pub enum StorageError {
 }
 
 /// A byte-addressable store of `capacity` bytes, erased to 0xFF like an EEPROM.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct MemStorage {
     bytes: Vec<u8>,
-    file: Option<PathBuf>,
+    /// Written through at the same offsets, so a save costs what it writes, not the file.
+    file: Option<File>,
     /// Writes so far, for tests that count them.
     pub writes: u64,
 }
@@ -26,14 +29,16 @@ impl MemStorage {
     }
 
     /// Backed by `path`: loaded from it if it exists, written through on every write.
-    pub fn with_file(capacity: usize, path: PathBuf) -> std::io::Result<Self> {
-        let mut bytes = match std::fs::read(&path) {
+    pub fn with_file(capacity: usize, path: &Path) -> std::io::Result<Self> {
+        let mut bytes = match std::fs::read(path) {
             Ok(b) => b,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
             Err(e) => return Err(e),
         };
         bytes.resize(capacity, 0xFF);
-        Ok(MemStorage { bytes, file: Some(path), writes: 0 })
+        let mut file = std::fs::OpenOptions::new().create(true).truncate(false).write(true).open(path)?;
+        file.write_all(&bytes)?;
+        Ok(MemStorage { bytes, file: Some(file), writes: 0 })
     }
 
     pub fn bytes(&self) -> &[u8] {
@@ -77,8 +82,8 @@ impl Storage for MemStorage {
         let r = self.range(offset, bytes.len())?;
         self.bytes.get_mut(r).ok_or(StorageError::OutOfBounds)?.copy_from_slice(bytes);
         self.writes += 1;
-        if let Some(path) = &self.file {
-            std::fs::write(path, &self.bytes).map_err(|e| StorageError::File(e.to_string()))?;
+        if let Some(file) = &mut self.file {
+            file.seek(SeekFrom::Start(u64::from(offset))).and_then(|_| file.write_all(bytes)).map_err(|e| StorageError::File(e.to_string()))?;
         }
         Ok(())
     }

@@ -179,3 +179,30 @@ fn tpdo_remapping_and_transmission_types() {
     bus.send(sync);
     assert_eq!(bus.drain(), vec![frame(0x185, &[0xAB, 0x00])]);
 }
+
+#[test]
+fn expedited_download_without_size_takes_the_entry_size() {
+    let mut bus = bus("co401gw1");
+    // 0x22: expedited, size not indicated; 1017h is UNSIGNED16, so 2 of the 4 bytes count.
+    assert_eq!(sdo(&mut bus, [0x22, 0x17, 0x10, 0, 0x34, 0x12, 0, 0])[0], 0x60);
+    assert_eq!(upload(&mut bus, 0x1017, 0).unwrap(), vec![0x34, 0x12]);
+    // An explicit size of 4 is still checked against the 2-byte entry.
+    assert_eq!(sdo(&mut bus, [0x23, 0x17, 0x10, 0, 0x34, 0x12, 0, 0])[0], 0x80, "size 4 given for a 2-byte entry");
+}
+
+#[test]
+fn stored_parameters_survive_reset_and_restore_brings_defaults_back() {
+    let mut bus = bus("co401gw1");
+    download(&mut bus, 0x100C, 0, &500_u16.to_le_bytes()).unwrap();
+    assert_eq!(download(&mut bus, 0x1010, 1, b"SAVE"), Err(0x0800_0020), "wrong signature");
+    download(&mut bus, 0x1010, 1, b"save").unwrap();
+    download(&mut bus, 0x100C, 0, &700_u16.to_le_bytes()).unwrap();
+    nmt(&mut bus, 0x81);
+    bus.drain();
+    assert_eq!(upload(&mut bus, 0x100C, 0).unwrap(), 500_u16.to_le_bytes().to_vec(), "the stored value, not the last one");
+    download(&mut bus, 0x1011, 1, b"load").unwrap();
+    assert_eq!(upload(&mut bus, 0x100C, 0).unwrap(), 500_u16.to_le_bytes().to_vec(), "restore takes effect at the next reset");
+    nmt(&mut bus, 0x81);
+    bus.drain();
+    assert_eq!(upload(&mut bus, 0x100C, 0).unwrap(), vec![0, 0], "spec default");
+}

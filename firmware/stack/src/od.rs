@@ -190,6 +190,11 @@ impl EntryInfo {
     /// Whether `side` may write `data` to this entry: access, state, length and value.
     pub fn check_write(&self, side: Side, ctx: &AccessContext, data: &[u8]) -> Result<(), SdoAbort> {
         self.check_write_access(side, ctx)?;
+        self.check_data(data)
+    }
+
+    /// Whether `data` fits this entry: length and value, whoever writes it.
+    pub fn check_data(&self, data: &[u8]) -> Result<(), SdoAbort> {
         self.check_length(data.len())?;
         self.check_value(data)
     }
@@ -294,28 +299,57 @@ pub fn read_slice(value: &[u8], offset: usize, buf: &mut [u8]) -> Result<ReadLen
 /// Finds the description of `index`/`sub` in a table sorted by `(index, sub)` whose runs do
 /// not overlap: `NoObject` if the index is absent, `NoSubIndex` if only the sub-index is.
 pub fn find(entries: &[EntryInfo], index: u16, sub: u8) -> Result<&EntryInfo, SdoAbort> {
+    find_run(entries, index, sub).and_then(|run| entries.get(run).ok_or(SdoAbort::NoObject))
+}
+
+/// Like [`find`], but the position of the run in the table (PDO mappings keep it).
+pub fn find_run(entries: &[EntryInfo], index: u16, sub: u8) -> Result<usize, SdoAbort> {
     // The last run that starts at or before (index, sub).
     let after = entries.partition_point(|e| (e.index, e.sub) <= (index, sub));
-    let candidate = after.checked_sub(1).and_then(|i| entries.get(i));
+    let candidate = after.checked_sub(1).and_then(|i| entries.get(i).map(|e| (i, e)));
     match candidate {
-        Some(e) if e.index == index && e.covers(sub) => Ok(e),
-        Some(e) if e.index == index => Err(SdoAbort::NoSubIndex),
+        Some((i, e)) if e.index == index && e.covers(sub) => Ok(i),
+        Some((_, e)) if e.index == index => Err(SdoAbort::NoSubIndex),
         _ if entries.get(after).is_some_and(|e| e.index == index) => Err(SdoAbort::NoSubIndex),
         _ => Err(SdoAbort::NoObject),
     }
 }
 
 /// The dictionary of one device: implemented by the code `device!` generates.
+///
+/// The generated code provides the table and the typed dispatch (`read_entry`,
+/// `write_entry`); lookups and access checks are the provided methods, so every device
+/// refuses the same accesses with the same codes.
 pub trait ObjectDictionary {
+    /// Every entry description, sorted by index and sub-index (see [`find`]).
+    fn entries(&self) -> &'static [EntryInfo];
+
+    /// Reads the value of the entry `info` describes, at `sub`, from byte `offset` into
+    /// `buf`: no lookup and no access check (the caller made both).
+    fn read_entry(&mut self, info: &EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
+
+    /// Writes `data` (the whole value, little-endian) after its length and value checks; no
+    /// lookup and no access check. A refused write leaves the stored value unchanged.
+    fn write_entry(&mut self, info: &EntryInfo, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
+
     /// The entry's metadata, or `NoObject` / `NoSubIndex`.
-    fn entry(&self, index: u16, sub: u8) -> Result<&EntryInfo, SdoAbort>;
+    fn entry(&self, index: u16, sub: u8) -> Result<&'static EntryInfo, SdoAbort> {
+        find(self.entries(), index, sub)
+    }
 
     /// Reads the value from byte `offset` into `buf`, after the access check for `side`.
-    fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8], side: Side) -> Result<ReadLen, SdoAbort>;
+    fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8], side: Side) -> Result<ReadLen, SdoAbort> {
+        let info = self.entry(index, sub)?;
+        info.check_read(side)?;
+        self.read_entry(info, sub, offset, buf)
+    }
 
-    /// Writes `data` (the whole value, little-endian) after the checks for `side`. A refused
-    /// write leaves the stored value unchanged.
-    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side, ctx: &AccessContext) -> Result<(), SdoAbort>;
+    /// Writes `data` after the checks for `side`: access, state, length and value.
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side, ctx: &AccessContext) -> Result<(), SdoAbort> {
+        let info = self.entry(index, sub)?;
+        info.check_write_access(side, ctx)?;
+        self.write_entry(info, sub, data)
+    }
 }
 
 /// A range of object indices: what 1010h/1011h sub-indices and NMT resets act on.

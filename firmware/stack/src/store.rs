@@ -93,11 +93,13 @@ impl<S: Storage> BlockStore<S> {
         self.base.checked_add(HEADER)?.checked_add(u32::try_from(offset).ok()?)
     }
 
+    /// Magic, length and CRC; a header whose reserved bytes are not zero reads as no magic.
     fn header(&mut self) -> Result<([u8; 4], u32, u16), StoreError> {
         let mut h = [0_u8; HEADER as usize];
         self.storage.read(self.base, &mut h).map_err(|_| StoreError::Device)?;
-        let [m0, m1, m2, m3, l0, l1, l2, l3, c0, c1, _, _] = h;
-        Ok(([m0, m1, m2, m3], u32::from_le_bytes([l0, l1, l2, l3]), u16::from_le_bytes([c0, c1])))
+        let [m0, m1, m2, m3, l0, l1, l2, l3, c0, c1, r0, r1] = h;
+        let magic = if [r0, r1] == [0, 0] { [m0, m1, m2, m3] } else { [0; 4] };
+        Ok((magic, u32::from_le_bytes([l0, l1, l2, l3]), u16::from_le_bytes([c0, c1])))
     }
 
     /// CRC of `len` data bytes, read back in small chunks.

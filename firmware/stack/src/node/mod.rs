@@ -449,13 +449,19 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
     }
 
+    /// Writes a received payload to the mapped objects. An entry the dictionary refuses (a
+    /// value out of range) keeps its value; the others are written, with their side effects.
     fn apply_rpdo(&mut self, r: &Rpdo, data: &[u8]) {
-        let mut written: Vec<(u16, u8), 8> = Vec::new();
-        r.mapping.unpack(&mut self.od, data, |index, sub| {
-            let _ = written.push((index, sub));
-        });
-        for (index, sub) in written {
-            self.after_write(index, sub);
+        let entries = self.od.entries();
+        let mut at = 0;
+        for m in r.mapping.entries() {
+            let end = at + usize::from(m.bytes);
+            if let (Some(src), Some(info)) = (data.get(at..end), m.info(entries))
+                && self.od.write_entry(info, m.sub, src).is_ok()
+            {
+                self.after_write(info.index, m.sub);
+            }
+            at = end;
         }
         self.event(NodeEvent::RpdoReceived(r.offset));
     }
@@ -703,8 +709,14 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     }
 
     pub(super) fn refresh_tpdo_filter(&mut self) {
-        self.tpdo_mapped =
-            self.tpdos.iter().filter(|t| t.comm.valid()).flat_map(|t| t.mapping.entries()).fold(0, |acc, m| acc | Self::filter_bit(m.index, m.sub));
+        let entries = self.od.entries();
+        self.tpdo_mapped = self
+            .tpdos
+            .iter()
+            .filter(|t| t.comm.valid())
+            .flat_map(|t| t.mapping.entries())
+            .filter_map(|m| m.info(entries).map(|i| Self::filter_bit(i.index, m.sub)))
+            .fold(0, |acc, bit| acc | bit);
     }
 
     /// SYNC, EMCY, heartbeat, guarding and consumer parameters.

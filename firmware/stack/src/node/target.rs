@@ -11,13 +11,14 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     /// own checks, then whatever the new value changes.
     pub(super) fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
         let ctx = self.ctx();
-        let entry = *self.od.entry(index, sub)?;
+        let entry = self.od.entry(index, sub)?;
         if matches!(index, 0x1010 | 0x1011) && sub >= 1 {
             entry.check_write(side, &ctx, data)?;
             return self.store_command(index, sub, data);
         }
         self.check_communication(index, sub, data, side)?;
-        self.od.write(index, sub, data, side, &ctx)?;
+        entry.check_write_access(side, &ctx)?;
+        self.od.write_entry(entry, sub, data)?;
         self.after_write(index, sub);
         if self.cfg.auto_save && entry.storage == Storage::Persistent && side != Side::Device {
             self.store.save(&self.od, crate::od::Area::ALL).map_err(|_| SdoAbort::Hardware)?;
@@ -48,8 +49,24 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         result.map_err(|_| SdoAbort::Hardware)
     }
 
-    /// Re-reads what a written object configures, and marks event-driven TPDOs that map it.
+    /// Marks the TPDOs that map a written object, and re-reads what a written communication
+    /// object configures.
     pub(super) fn after_write(&mut self, index: u16, sub: u8) {
+        if index < 0x2000 {
+            self.after_communication_write(index);
+        }
+        if self.tpdo_mapped & Self::filter_bit(index, sub) == 0 {
+            return;
+        }
+        let entries = self.od.entries();
+        for t in &mut self.tpdos {
+            if t.comm.valid() && t.mapping.contains(entries, index, sub) {
+                t.trigger();
+            }
+        }
+    }
+
+    fn after_communication_write(&mut self, index: u16) {
         let now = self.now_us;
         match index {
             0x1005 => self.reload_sync(),
@@ -74,14 +91,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
                     self.refresh_tpdo_filter();
                 }
             }
-            None if self.tpdo_mapped & Self::filter_bit(index, sub) == 0 => {}
-            None => {
-                for t in &mut self.tpdos {
-                    if t.comm.valid() && t.mapping.contains(index, sub) {
-                        t.trigger();
-                    }
-                }
-            }
+            None => {}
         }
     }
 }
@@ -103,6 +113,11 @@ impl<D: Dictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, P> {
 
     fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
         Core::write(self, index, sub, data, Side::Bus)
+    }
+
+    fn fixed_size(&mut self, index: u16, sub: u8) -> Option<usize> {
+        let e = self.od.entry(index, sub).ok()?;
+        e.data_type.bits().map(|_| usize::from(e.size))
     }
 }
 

@@ -2,18 +2,23 @@
 //! mapped values into a frame.
 
 use super::Dir;
-use crate::od::{DataType, ObjectDictionary, SdoAbort, Side};
+use crate::od::{DataType, EntryInfo, ObjectDictionary, SdoAbort, find_run};
 
 /// Most entries a PDO maps (one per byte of a CAN frame).
 pub const MAX_MAPPED: usize = 8;
 
-/// One mapped object, byte-aligned.
+/// One mapped object, byte-aligned. It keeps the position of its entry in the dictionary's
+/// table, so sending and receiving a PDO needs no lookup.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Mapped {
-    pub index: u16,
+    /// Position in [`ObjectDictionary::entries`], or [`DUMMY`].
+    pub run: u16,
     pub sub: u8,
     pub bytes: u8,
 }
+
+/// The `run` of a dummy entry (indices 0002h..0007h fill RPDO bytes nobody needs).
+pub const DUMMY: u16 = u16::MAX;
 
 impl Mapped {
     /// Decodes `index << 16 | sub << 8 | bits`.
@@ -21,9 +26,13 @@ impl Mapped {
         ((word >> 16) as u16, (word >> 8) as u8, word as u8)
     }
 
-    /// Dummy entries (indices 0002h..0007h) fill RPDO bytes nobody needs.
     pub const fn is_dummy(&self) -> bool {
-        self.index < 0x0020
+        self.run == DUMMY
+    }
+
+    /// The mapped entry's description.
+    pub fn info<'t>(&self, entries: &'t [EntryInfo]) -> Option<&'t EntryInfo> {
+        entries.get(usize::from(self.run))
     }
 }
 
@@ -47,9 +56,11 @@ pub fn check_entry(od: &impl ObjectDictionary, word: u32, dir: Dir) -> Result<Ma
     }
     let bytes = bits / 8;
     if let Some(size) = dummy_bytes(index) {
-        return if dir == Dir::Rx && size == bytes && sub == 0 { Ok(Mapped { index, sub, bytes }) } else { Err(SdoAbort::NotMappable) };
+        return if dir == Dir::Rx && size == bytes && sub == 0 { Ok(Mapped { run: DUMMY, sub, bytes }) } else { Err(SdoAbort::NotMappable) };
     }
-    let e = od.entry(index, sub)?;
+    let entries = od.entries();
+    let run = find_run(entries, index, sub)?;
+    let e = entries.get(run).ok_or(SdoAbort::NoObject)?;
     let allowed = match dir {
         Dir::Rx => e.access.writable(),
         Dir::Tx => e.access.readable(),
@@ -59,7 +70,8 @@ pub fn check_entry(od: &impl ObjectDictionary, word: u32, dir: Dir) -> Result<Ma
     }
     let variable = matches!(e.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
     let fits = if variable { u16::from(bytes) <= e.size } else { u16::from(bytes) == e.size };
-    if fits { Ok(Mapped { index, sub, bytes }) } else { Err(SdoAbort::NotMappable) }
+    let run = u16::try_from(run).map_err(|_| SdoAbort::NotMappable)?;
+    if fits { Ok(Mapped { run, sub, bytes }) } else { Err(SdoAbort::NotMappable) }
 }
 
 /// A PDO's mapping, checked and cached so that sending and receiving need no lookups of the
@@ -102,37 +114,21 @@ impl Mapping {
         self.count == 0
     }
 
-    pub fn contains(&self, index: u16, sub: u8) -> bool {
-        self.entries().iter().any(|e| e.index == index && e.sub == sub)
+    pub fn contains(&self, entries: &[EntryInfo], index: u16, sub: u8) -> bool {
+        self.entries().iter().any(|e| e.sub == sub && e.info(entries).is_some_and(|i| i.index == index))
     }
 
     /// Reads the mapped values into a frame payload; returns its length.
     pub fn pack(&self, od: &mut impl ObjectDictionary, out: &mut [u8; 8]) -> Result<usize, SdoAbort> {
+        let entries = od.entries();
         let mut at = 0;
         for e in self.entries() {
             let end = at + usize::from(e.bytes);
             let dst = out.get_mut(at..end).ok_or(SdoAbort::PdoTooLong)?;
             dst.fill(0);
-            od.read(e.index, e.sub, 0, dst, Side::Device)?;
+            od.read_entry(e.info(entries).ok_or(SdoAbort::NoObject)?, e.sub, 0, dst)?;
             at = end;
         }
         Ok(at)
-    }
-
-    /// Writes a received payload to the mapped objects; entries the dictionary refuses (a value
-    /// out of range) keep their value, the others are written. Returns the objects written.
-    pub fn unpack(&self, od: &mut impl ObjectDictionary, data: &[u8], mut written: impl FnMut(u16, u8)) {
-        let ctx = crate::od::AccessContext { nmt: crate::od::NmtState::Operational, can_enabled: true };
-        let mut at = 0;
-        for e in self.entries() {
-            let end = at + usize::from(e.bytes);
-            if let Some(src) = data.get(at..end)
-                && !e.is_dummy()
-                && od.write(e.index, e.sub, src, Side::Device, &ctx).is_ok()
-            {
-                written(e.index, e.sub);
-            }
-            at = end;
-        }
     }
 }

@@ -80,6 +80,12 @@ pub trait SdoTarget {
 
     /// Writes the whole value; a refused write changes nothing.
     fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
+
+    /// The fixed size of the entry's value, if it has one (not a string or domain): an
+    /// expedited download that gives no size carries that many bytes (CiA 301 7.2.4.3.3).
+    fn fixed_size(&mut self, _index: u16, _sub: u8) -> Option<usize> {
+        None
+    }
 }
 
 /// The default SDO timeout: 1 s.

@@ -19,13 +19,13 @@ pub(super) struct Download {
 
 /// Initiate download: an expedited one is written at once, a segmented one starts.
 ///
-/// Expedited with `s = 0` carries no size: CiA 301 leaves it unspecified, so all four bytes
-/// are written and the dictionary's length check decides (a 1-byte object then refuses with
-/// its own code).
+/// Expedited with `s = 0` carries "an unspecified number of bytes": the entry's own size if
+/// it has a fixed one of at most 4 bytes, otherwise all four bytes, and the dictionary's
+/// length check decides.
 pub(super) fn initiate_download(init: &InitDownload, capacity: usize, target: &mut impl SdoTarget) -> Started {
     let mux = init.mux;
     if init.expedited {
-        let len = if init.sized { 4 - usize::from(init.n) } else { 4 };
+        let len = if init.sized { 4 - usize::from(init.n) } else { target.fixed_size(mux.index, mux.sub).filter(|&n| n <= 4).unwrap_or(4) };
         let data = init.data.get(..len).ok_or(SdoAbort::General)?;
         target.check_download(mux.index, mux.sub, Some(len))?;
         target.write(mux.index, mux.sub, data)?;
