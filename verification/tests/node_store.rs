@@ -32,10 +32,9 @@ fn a_saved_block_loads_back() {
 
 #[test]
 fn every_corrupted_byte_falls_back_to_defaults() {
-    let len = usize::try_from(12 + <Od<NoAppObjects> as coforge_stack::od::Dictionary>::PERSISTENT_SIZE).expect("small");
+    let len = 12 + <Od<NoAppObjects> as coforge_stack::od::Dictionary>::PERSISTENT_SIZE;
     for at in 0..len {
-        let mut store = saved_block();
-        let mut image = store.into_inner();
+        let mut image = saved_block().into_inner();
         // Every byte of header (magic, length, CRC, reserved) and data.
         image.0[at] ^= 0x5A;
         let mut store = BlockStore::new(image, 0);
