@@ -27,6 +27,8 @@ pub trait SimNode: Send {
     fn trigger_tpdo(&mut self, number: u16);
     /// Static RAM of the node (its `size_of`).
     fn ram_bytes(&self) -> usize;
+    /// CiA 303-3 indicator states.
+    fn leds(&self) -> coforge_stack::leds::Leds;
 }
 
 impl<D, S, const N: usize, const P: usize> SimNode for Node<D, S, N, P>
@@ -74,6 +76,9 @@ where
     }
     fn ram_bytes(&self) -> usize {
         core::mem::size_of::<Self>()
+    }
+    fn leds(&self) -> coforge_stack::leds::Leds {
+        Node::leds(self)
     }
 }
 

@@ -206,3 +206,88 @@ fn stored_parameters_survive_reset_and_restore_brings_defaults_back() {
     bus.drain();
     assert_eq!(upload(&mut bus, 0x100C, 0).unwrap(), vec![0, 0], "spec default");
 }
+
+fn emcy_frames(bus: &mut VirtualBus) -> Vec<[u8; 8]> {
+    bus.drain().into_iter().filter(|f| f.id == 0x80 + u16::from(ID)).map(|f| f.data).collect()
+}
+
+#[test]
+fn sync_cycle_monitoring_from_1006() {
+    let mut bus = bus("cr3101");
+    download(&mut bus, 0x1006, 0, &100_000_u32.to_le_bytes()).unwrap();
+    bus.drain();
+    bus.advance_ms(500);
+    assert!(emcy_frames(&mut bus).is_empty(), "monitoring starts with the first SYNC");
+    bus.send(frame(0x080, &[]));
+    bus.advance_ms(150);
+    assert!(emcy_frames(&mut bus).is_empty(), "within 1.5 cycles");
+    bus.advance_ms(1);
+    assert_eq!(emcy_frames(&mut bus), vec![[0x00, 0x81, 0x11, 0, 0, 0, 0, 0]], "SYNC timeout");
+    bus.advance_ms(500);
+    assert!(emcy_frames(&mut bus).is_empty(), "reported once");
+    bus.send(frame(0x080, &[]));
+    assert_eq!(emcy_frames(&mut bus), vec![[0, 0, 0, 0, 0, 0, 0, 0]], "the next SYNC resets the error");
+}
+
+#[test]
+fn rpdo_deadline_monitoring_from_its_event_timer() {
+    let mut bus = bus("co401gw1");
+    download(&mut bus, 0x1400, 5, &50_u16.to_le_bytes()).unwrap();
+    nmt(&mut bus, 0x01);
+    bus.drain();
+    bus.advance_ms(200);
+    assert!(emcy_frames(&mut bus).is_empty(), "monitoring starts with the first RPDO");
+    bus.send(frame(0x205, &[0; 8]));
+    bus.advance_ms(50);
+    assert!(emcy_frames(&mut bus).is_empty());
+    bus.advance_ms(1);
+    assert_eq!(emcy_frames(&mut bus), vec![[0x50, 0x82, 0x11, 0, 0, 0, 0, 0]], "RPDO timeout 8250h");
+    bus.send(frame(0x205, &[0; 8]));
+    assert_eq!(emcy_frames(&mut bus), vec![[0, 0, 0, 0, 0, 0, 0, 0]], "the next RPDO resets the error");
+}
+
+#[test]
+fn boot_up_message_can_be_switched_off_by_2110() {
+    let mut bus = bus("co401gw1");
+    download(&mut bus, 0x2110, 0, &[0]).unwrap();
+    nmt(&mut bus, 0x82);
+    assert!(bus.drain().is_empty(), "no boot-up with 2110h = 0");
+    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational);
+    download(&mut bus, 0x2110, 0, &[1]).unwrap();
+    nmt(&mut bus, 0x82);
+    assert_eq!(bus.drain(), vec![frame(0x705, &[0])]);
+}
+
+#[test]
+fn bus_off_restart_and_return_emergency() {
+    use coforge_stack::leds::LedState;
+    use coforge_stack::node::{BusState, NodeEvent};
+    let mut bus = bus("co401gw1");
+    download(&mut bus, 0x1017, 0, &100_u16.to_le_bytes()).unwrap();
+    nmt(&mut bus, 0x01);
+    bus.drain();
+    while bus.nodes[0].take_event().is_some() {}
+    let now = bus.now_us();
+    bus.nodes[0].on_bus_state(BusState::BusOff, now);
+    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational, "1029h sub 1 = 0: a communication error leaves Operational");
+    assert_eq!(bus.nodes[0].leds().error, LedState::On, "CiA 303-3: bus-off lights the error LED");
+    bus.advance_ms(999);
+    assert!(bus.drain().is_empty(), "nothing is sent while bus-off");
+    assert_eq!(bus.nodes[0].take_event(), Some(NodeEvent::StateChanged(NmtState::PreOperational)));
+    assert_eq!(bus.nodes[0].take_event(), None, "restart only after 2180h = 1000 ms");
+    bus.advance_ms(1);
+    assert_eq!(bus.nodes[0].take_event(), Some(NodeEvent::RestartController));
+    let now = bus.now_us();
+    bus.nodes[0].on_bus_state(BusState::Active, now);
+    bus.advance_ms(1);
+    let emcy = emcy_frames(&mut bus);
+    assert_eq!(emcy[0], [0x40, 0x81, 0x01, 0, 0, 0, 0, 0xC0], "the datasheet's return-from-bus-off frame: {emcy:02X?}");
+    assert_eq!(emcy[1], [0, 0, 0, 0, 0, 0, 0, 0], "then error reset");
+    assert_eq!(bus.nodes[0].leds().error, LedState::Off);
+    assert_eq!(bus.nodes[0].leds().run, LedState::Blinking, "pre-operational");
+    let now = bus.now_us();
+    bus.nodes[0].on_bus_state(BusState::Warning, now);
+    bus.advance_ms(1);
+    assert_eq!(emcy_frames(&mut bus), vec![[0x00, 0x81, 0x01, 0, 0, 0, 0, 0x40]], "spec can_warning emergency");
+    assert_eq!(bus.nodes[0].leds().error, LedState::SingleFlash);
+}

@@ -50,17 +50,25 @@ impl EmcyDefault {
 /// Error register bits (1001h): bit 0 generic, bit 4 communication, and so on.
 pub type ErrorRegister = u8;
 
-/// One active error: its code and manufacturer bytes identify it.
+/// One active error: its code, manufacturer bytes and stack event identify it (two CiA
+/// defaults may share a code, such as 8100h for a CAN warning and a SYNC timeout).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Active {
     code: u16,
     register: ErrorRegister,
     manufacturer: [u8; 5],
+    event: Option<EmcyEvent>,
+}
+
+impl Active {
+    fn is(&self, e: &EmcyDefault) -> bool {
+        self.code == e.code && self.manufacturer == e.manufacturer && self.event == e.event
+    }
 }
 
 /// How many errors can be active at once; more are still sent, but not tracked for 1001h.
 pub const MAX_ACTIVE: usize = 8;
-const QUEUE: usize = 8;
+const QUEUE: usize = 6;
 
 /// What the producer changed, for the node to mirror into the dictionary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -91,25 +99,25 @@ impl EmcyProducer {
         if self.active.is_empty() { 0 } else { bits | 0x01 }
     }
 
-    pub fn is_active(&self, code: u16, manufacturer: [u8; 5]) -> bool {
-        self.active.iter().any(|a| a.code == code && a.manufacturer == manufacturer)
+    pub fn is_active(&self, e: &EmcyDefault) -> bool {
+        self.active.iter().any(|a| a.is(e))
     }
 
     /// Raises an error; `None` if it was already active (nothing is sent twice).
     pub fn raise(&mut self, e: &EmcyDefault) -> Option<Change> {
-        if self.is_active(e.code, e.manufacturer) {
+        if self.is_active(e) {
             return None;
         }
         // A full table still reports the error; it only cannot be cleared individually.
-        let _ = self.active.push(Active { code: e.code, register: e.register, manufacturer: e.manufacturer });
+        let _ = self.active.push(Active { code: e.code, register: e.register, manufacturer: e.manufacturer, event: e.event });
         let register = self.register();
         self.enqueue(e.code, register, e.manufacturer);
         Some(Change { register, history: Some(u32::from(e.code) | u32::from(e.manufacturer[0]) << 16 | u32::from(e.manufacturer[1]) << 24) })
     }
 
     /// Clears an active error and sends "error reset" (code 0000h) with what remains.
-    pub fn clear(&mut self, code: u16, manufacturer: [u8; 5]) -> Option<Change> {
-        let at = self.active.iter().position(|a| a.code == code && a.manufacturer == manufacturer)?;
+    pub fn clear(&mut self, e: &EmcyDefault) -> Option<Change> {
+        let at = self.active.iter().position(|a| a.is(e))?;
         self.active.swap_remove(at);
         let register = self.register();
         self.enqueue(0x0000, register, [0; 5]);
@@ -170,8 +178,8 @@ mod tests {
         let guard = EmcyDefault::for_event(EmcyEvent::LifeGuarding, &[]);
         assert_eq!((guard.code, guard.register), (0x8130, 0x11));
         assert_eq!(p.raise(&guard).unwrap().register, 0x13);
-        assert_eq!(p.clear(OVERLOAD.code, OVERLOAD.manufacturer).unwrap().register, 0x11);
-        assert_eq!(p.clear(OVERLOAD.code, OVERLOAD.manufacturer), None, "already cleared");
+        assert_eq!(p.clear(&OVERLOAD).unwrap().register, 0x11);
+        assert_eq!(p.clear(&OVERLOAD), None, "already cleared");
         assert_eq!(p.next(0, 0), Some([0x10, 0x23, 0x03, 0, 1, 0, 0, 0]));
         assert_eq!(p.next(0, 0), Some([0x30, 0x81, 0x13, 0, 0, 0, 0, 0]));
         assert_eq!(p.next(0, 0), Some([0x00, 0x00, 0x11, 0, 0, 0, 0, 0]), "error reset carries what remains");
@@ -182,7 +190,7 @@ mod tests {
     fn inhibit_time_spaces_frames() {
         let mut p = EmcyProducer::new();
         p.raise(&OVERLOAD);
-        p.clear(OVERLOAD.code, OVERLOAD.manufacturer);
+        p.clear(&OVERLOAD);
         assert!(p.next(1_000, 50).is_some());
         assert_eq!(p.next(5_999, 50), None, "5 ms inhibit");
         assert!(p.next(6_000, 50).is_some());

@@ -433,10 +433,14 @@ pub enum EmcyEvent {
     BusOffRecovered,
     /// A received PDO was shorter than its mapping.
     RpdoLength,
+    /// No SYNC within 1.5 times the communication cycle period (1006h).
+    SyncTimeout,
+    /// An RPDO did not arrive within its event timer (CiA 301 RPDO deadline monitoring).
+    RpdoTimeout,
 }
 
 impl EmcyEvent {
-    pub const ALL: [EmcyEvent; 9] = [
+    pub const ALL: [EmcyEvent; 11] = [
         EmcyEvent::LifeGuarding,
         EmcyEvent::GuardingWarning,
         EmcyEvent::HeartbeatTimeout,
@@ -446,6 +450,8 @@ impl EmcyEvent {
         EmcyEvent::BusOff,
         EmcyEvent::BusOffRecovered,
         EmcyEvent::RpdoLength,
+        EmcyEvent::SyncTimeout,
+        EmcyEvent::RpdoTimeout,
     ];
 
     /// The spec keyword.
@@ -460,6 +466,8 @@ impl EmcyEvent {
             EmcyEvent::BusOff => "bus_off",
             EmcyEvent::BusOffRecovered => "bus_off_recovered",
             EmcyEvent::RpdoLength => "rpdo_length",
+            EmcyEvent::SyncTimeout => "sync_timeout",
+            EmcyEvent::RpdoTimeout => "rpdo_timeout",
         }
     }
 
@@ -476,6 +484,8 @@ impl EmcyEvent {
             EmcyEvent::CanPassive => 0x8120,
             EmcyEvent::BusOff | EmcyEvent::BusOffRecovered => 0x8140,
             EmcyEvent::RpdoLength => 0x8210,
+            EmcyEvent::SyncTimeout => 0x8100,
+            EmcyEvent::RpdoTimeout => 0x8250,
         }
     }
 

@@ -6,7 +6,8 @@
 
 coforge_macros::device!("../../../spec/co401memory1.yaml");
 
-/// The CANopen node's settings beyond CiA 301: the frenzel+berg bus-off restart time (2180h).
+/// The CANopen node's settings beyond CiA 301: the frenzel+berg bus-off restart time (2180h)
+/// and boot-up message switch (2110h).
 pub const fn node_config(node_id: u8) -> coforge_stack::node::NodeConfig {
-    coforge_stack::node::NodeConfig { restart_time_object: Some(0x2180), ..coforge_stack::node::NodeConfig::new(node_id) }
+    coforge_stack::node::NodeConfig { restart_time_object: Some(0x2180), bootup_object: Some(0x2110), ..coforge_stack::node::NodeConfig::new(node_id) }
 }

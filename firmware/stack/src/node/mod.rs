@@ -46,11 +46,13 @@ pub struct NodeConfig {
     /// An object holding the bus-off restart time in ms, 0 = no automatic restart
     /// (frenzel+berg 2180h "CAN Restart Time").
     pub restart_time_object: Option<u16>,
+    /// An object whose value 0 suppresses the boot-up message (frenzel+berg 2110h).
+    pub bootup_object: Option<u16>,
 }
 
 impl NodeConfig {
     pub const fn new(node_id: u8) -> Self {
-        NodeConfig { node_id, sdo_timeout_us: 1_000_000, startup_object: None, auto_save: false, restart_time_object: None }
+        NodeConfig { node_id, sdo_timeout_us: 1_000_000, startup_object: None, auto_save: false, restart_time_object: None, bootup_object: None }
     }
 }
 
@@ -76,7 +78,7 @@ pub enum NodeEvent {
     RestartController,
 }
 
-const TX_QUEUE: usize = 16;
+const TX_QUEUE: usize = 12;
 const EVENTS: usize = 4;
 
 /// Everything except the SDO server, which borrows it as its [`crate::sdo::SdoTarget`].
@@ -99,6 +101,12 @@ pub struct Core<D, S, const P: usize> {
     emcy_cob: Option<u16>,
     emcy_inhibit: u16,
     sync_cob: Option<u16>,
+    /// 1006h communication cycle period in us (0: SYNC not monitored).
+    sync_period_us: u32,
+    /// When the last SYNC arrived; monitoring starts with the first one.
+    last_sync_us: Option<u64>,
+    /// The SYNC timeout was reported and waits for the next SYNC to end it.
+    sync_lost: bool,
     heartbeat: Producer,
     consumer: Consumer,
     guarding: Guarding,
@@ -140,6 +148,9 @@ impl<D: Dictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N,
             emcy_cob: None,
             emcy_inhibit: 0,
             sync_cob: None,
+            sync_period_us: 0,
+            last_sync_us: None,
+            sync_lost: false,
             heartbeat: Producer::default(),
             consumer: Consumer::default(),
             guarding: Guarding::default(),
@@ -192,6 +203,11 @@ impl<D: Dictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N,
     pub fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
         self.core.now_us = now_us;
         if !self.core.started {
+            return None;
+        }
+        // A bus-off controller cannot send: frames wait in the queue for the restart.
+        if self.core.bus == BusState::BusOff {
+            self.core.check_restart(now_us);
             return None;
         }
         if let Some(frame) = self.core.tx.pop_front() {
@@ -320,6 +336,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             if state != NmtState::Operational {
                 for r in &mut self.rpdos {
                     r.latched = None;
+                    r.deadline_us = crate::pdo::slot::NEVER;
                 }
             } else {
                 let now = self.now_us;
@@ -345,7 +362,11 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         self.state = NmtState::PreOperational;
         self.reload_all(now_us);
         self.mirror_error_register(0);
-        self.send(0x700 + u16::from(self.node_id), &[0x00]);
+        self.last_sync_us = None;
+        self.sync_lost = false;
+        if self.cfg.bootup_object.and_then(|i| read_u32(&mut self.od, i, 0)) != Some(0) {
+            self.send(0x700 + u16::from(self.node_id), &[0x00]);
+        }
         let operational = self.cfg.startup_object.and_then(|i| read_u32(&mut self.od, i, 0)) == Some(1);
         self.set_state(if operational { NmtState::Operational } else { NmtState::PreOperational });
     }
@@ -375,6 +396,10 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
                 [c] => Some(*c),
                 _ => return,
             };
+            self.last_sync_us = Some(now_us);
+            if core::mem::take(&mut self.sync_lost) {
+                self.clear_event(EmcyEvent::SyncTimeout);
+            }
             if nmt::allows_pdo(state) {
                 self.on_sync(counter);
             }
@@ -435,6 +460,12 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
         // A PDO of the right length ends the length error.
         self.clear_event(EmcyEvent::RpdoLength);
+        let now = self.now_us;
+        if let Some(slot) = self.rpdos.get_mut(i)
+            && slot.received(now)
+        {
+            self.clear_event(EmcyEvent::RpdoTimeout);
+        }
         if r.comm.synchronous() {
             let mut buf = [0_u8; 8];
             let n = data.len().min(8);
@@ -530,18 +561,12 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         if let Some(ConsumerEvent::Lost(_)) = self.consumer.check(now_us) {
             self.raise_event(EmcyEvent::HeartbeatTimeout);
         }
+        self.check_deadlines(now_us);
         if nmt::allows_pdo(self.state) {
             for i in 0..self.tpdos.len() {
                 if self.tpdos.get_mut(i).is_some_and(|t| t.comm.valid() && t.due(now_us)) {
                     self.send_tpdo(i, now_us);
                 }
-            }
-        }
-        if let Some(since) = self.bus_off_since {
-            let restart_ms = self.cfg.restart_time_object.and_then(|i| read_u32(&mut self.od, i, 0));
-            if restart_ms.is_some_and(|ms| ms != 0 && now_us.saturating_sub(since) >= u64::from(ms) * 1000) {
-                self.bus_off_since = None;
-                self.event(NodeEvent::RestartController);
             }
         }
         self.send_emcy();
@@ -554,6 +579,40 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             && let Some(frame) = self.emcy.next(self.now_us, self.emcy_inhibit)
         {
             self.send(cob, &frame);
+        }
+    }
+
+    /// Bus-off: tells the board to restart the controller once the restart time has passed.
+    fn check_restart(&mut self, now_us: u64) {
+        let Some(since) = self.bus_off_since else { return };
+        let restart_ms = self.cfg.restart_time_object.and_then(|i| read_u32(&mut self.od, i, 0));
+        if restart_ms.is_some_and(|ms| ms != 0 && now_us.saturating_sub(since) >= u64::from(ms) * 1000) {
+            self.bus_off_since = None;
+            self.event(NodeEvent::RestartController);
+        }
+    }
+
+    /// SYNC cycle (1006h) and RPDO deadline monitoring.
+    fn check_deadlines(&mut self, now_us: u64) {
+        let period = u64::from(self.sync_period_us);
+        if period != 0
+            && nmt::allows_emcy_and_sync(self.state)
+            && !self.sync_lost
+            && self.last_sync_us.is_some_and(|t| now_us.saturating_sub(t) > period + period / 2)
+        {
+            // Reported once; the next SYNC ends it.
+            self.sync_lost = true;
+            self.raise_event(EmcyEvent::SyncTimeout);
+        }
+        if nmt::allows_pdo(self.state) {
+            // Every RPDO records its own timeout; one emergency covers them all.
+            let mut overdue = false;
+            for r in &mut self.rpdos {
+                overdue |= r.overdue(now_us);
+            }
+            if overdue {
+                self.raise_event(EmcyEvent::RpdoTimeout);
+            }
         }
     }
 
@@ -584,19 +643,23 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
     }
 
-    /// The spec emergency for a stack event; events the spec treats as optional
-    /// (the guarding warning) are only sent if the spec lists them.
+    /// The spec emergency for a stack event. Events whose frame is device-specific are only
+    /// sent if the spec lists them: the guarding warning, and bus-off and its end (a node
+    /// cannot send while bus-off; datasheets differ in what goes out on the return).
     fn event_emcy(&self, event: EmcyEvent) -> Option<EmcyDefault> {
         let spec = self.od.emergencies();
         match event {
-            EmcyEvent::GuardingWarning => spec.iter().find(|e| e.event == Some(event)).copied(),
+            EmcyEvent::GuardingWarning | EmcyEvent::BusOff | EmcyEvent::BusOffRecovered => spec.iter().find(|e| e.event == Some(event)).copied(),
             _ => Some(EmcyDefault::for_event(event, spec)),
         }
     }
 
     fn raise_event(&mut self, event: EmcyEvent) {
-        if let Some(e) = self.event_emcy(event) {
-            self.raise(&e, event.is_communication_error());
+        match self.event_emcy(event) {
+            Some(e) => self.raise(&e, event.is_communication_error()),
+            // Without an emergency to send, a communication error still gets its 1029h reaction.
+            None if event.is_communication_error() => self.react(Reaction::ErrorBehaviour, true),
+            None => {}
         }
     }
 
@@ -623,7 +686,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     }
 
     fn clear(&mut self, e: &EmcyDefault) {
-        if let Some(change) = self.emcy.clear(e.code, e.manufacturer) {
+        if let Some(change) = self.emcy.clear(e) {
             self.mirror_error_register(change.register);
         }
     }
@@ -679,6 +742,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         let error = match self.bus {
             BusState::BusOff => LedState::On,
             _ if self.guarding.lost() || self.consumer.any_lost() => LedState::DoubleFlash,
+            _ if self.sync_lost => LedState::TripleFlash,
             BusState::Warning | BusState::Passive => LedState::SingleFlash,
             BusState::Active => LedState::Off,
         };
@@ -730,6 +794,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
 
     pub(super) fn reload_sync(&mut self) {
         self.sync_cob = read_u32(&mut self.od, 0x1005, 0).map(|c| (c & 0x7FF) as u16).or(Some(0x080));
+        self.sync_period_us = read_u32(&mut self.od, 0x1006, 0).unwrap_or(0);
     }
 
     pub(super) fn reload_emcy(&mut self) {

@@ -69,7 +69,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     fn after_communication_write(&mut self, index: u16) {
         let now = self.now_us;
         match index {
-            0x1005 => self.reload_sync(),
+            0x1005 | 0x1006 => self.reload_sync(),
             0x100C..=0x100E => self.reload_guarding(),
             0x1014 | 0x1015 => self.reload_emcy(),
             0x1016 => self.reload_consumer(),

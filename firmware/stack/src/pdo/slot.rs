@@ -67,7 +67,7 @@ pub fn read_mapping(od: &mut impl ObjectDictionary, index: u16, dir: Dir) -> Map
 }
 
 /// A receive PDO.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Rpdo {
     /// 1400h + `offset` is its communication object.
     pub offset: u16,
@@ -75,12 +75,41 @@ pub struct Rpdo {
     pub mapping: Mapping,
     /// Data of a synchronous RPDO, applied at the next SYNC.
     pub latched: Option<([u8; 8], u8)>,
+    /// The next reception is due by then (event timer, sub 5); [`NEVER`] until the first
+    /// reception or without an event timer.
+    pub deadline_us: u64,
+    /// The deadline passed and was reported.
+    pub timed_out: bool,
 }
 
 impl Rpdo {
     pub fn load(od: &mut impl ObjectDictionary, offset: u16) -> Rpdo {
         let index = Dir::Rx.comm_base() + offset;
-        Rpdo { offset, comm: Comm::read(od, index), mapping: read_mapping(od, Dir::mapping_of(index), Dir::Rx), latched: None }
+        Rpdo {
+            offset,
+            comm: Comm::read(od, index),
+            mapping: read_mapping(od, Dir::mapping_of(index), Dir::Rx),
+            latched: None,
+            deadline_us: NEVER,
+            timed_out: false,
+        }
+    }
+
+    /// A reception at `now_us`: restarts deadline monitoring. True if it ends a timeout.
+    pub fn received(&mut self, now_us: u64) -> bool {
+        if self.comm.event_timer != 0 {
+            self.deadline_us = now_us + u64::from(self.comm.event_timer) * 1000;
+        }
+        core::mem::take(&mut self.timed_out)
+    }
+
+    /// Whether the deadline passed at `now_us` (reported once per timeout).
+    pub fn overdue(&mut self, now_us: u64) -> bool {
+        if self.comm.valid() && !self.timed_out && now_us > self.deadline_us {
+            self.timed_out = true;
+            return true;
+        }
+        false
     }
 }
 
