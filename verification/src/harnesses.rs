@@ -3,6 +3,7 @@
 
 use crate::framing::*;
 use crate::integrity::*;
+use crate::stack::*;
 use coforge_link::crc::Crc16;
 
 static TABLES: [Crc16; 3] = [Crc16::new(PARAMS[0]), Crc16::new(PARAMS[1]), Crc16::new(PARAMS[2])];
@@ -89,4 +90,26 @@ fn resync_after_4_bytes_of_garbage() {
     let garbage: [u8; 4] = kani::any();
     let data: [u8; 2] = kani::any();
     prop_resync_after_garbage(&garbage, kani::any(), &data);
+}
+
+#[kani::proof]
+#[kani::unwind(7)]
+fn emcy_register_follows_active_errors_for_6_operations() {
+    let ops: [u8; 6] = kani::any();
+    prop_emcy_register(&ops);
+}
+
+#[kani::proof]
+fn nmt_commands_address_only_this_node() {
+    let payload: [u8; 3] = kani::any();
+    let len: usize = kani::any();
+    kani::assume(len <= payload.len());
+    prop_nmt_parse(&payload[..len], kani::any());
+}
+
+#[kani::proof]
+#[kani::unwind(9)]
+fn sdo_first_request_answers_validly() {
+    let request: [u8; 8] = kani::any();
+    prop_sdo_first_request(&request);
 }

@@ -13,6 +13,7 @@
 pub mod framing;
 pub mod integrity;
 pub mod node;
+pub mod stack;
 
 #[cfg(kani)]
 mod harnesses;
