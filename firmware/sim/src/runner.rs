@@ -48,22 +48,33 @@ impl Drop for Running {
     }
 }
 
-/// Starts `nodes` on `hub`, each on its own port, stepped by one thread.
+/// Starts `nodes` on `hub`, each on its own port, stepped by one thread. Returns once every
+/// node has booted and its boot-up message is on the bus, so a client that connects after
+/// this never sees a boot-up it did not cause.
 pub fn spawn(hub: &Hub, nodes: Vec<Box<dyn SimNode>>) -> Running {
     let ports: Vec<Port> = nodes.iter().map(|_| hub.attach()).collect();
     let stop = Arc::new(AtomicBool::new(false));
     let stats = Arc::new(Stats::default());
     let (stop2, stats2) = (stop.clone(), stats.clone());
-    let thread = std::thread::Builder::new().name("coforge-sim".into()).spawn(move || run(nodes, ports, &stop2, &stats2)).ok();
+    let (booted_tx, booted) = std::sync::mpsc::channel();
+    let thread = std::thread::Builder::new().name("coforge-sim".into()).spawn(move || run(nodes, ports, &stop2, &stats2, &booted_tx)).ok();
+    // If the thread could not start, there is nothing to wait for.
+    if thread.is_some() {
+        let _ = booted.recv();
+    }
     Running { stop, thread, stats }
 }
 
-fn run(mut nodes: Vec<Box<dyn SimNode>>, ports: Vec<Port>, stop: &AtomicBool, stats: &Stats) {
+fn run(mut nodes: Vec<Box<dyn SimNode>>, ports: Vec<Port>, stop: &AtomicBool, stats: &Stats, booted: &std::sync::mpsc::Sender<()>) {
     let epoch = Instant::now();
     let now_us = || u64::try_from(epoch.elapsed().as_micros()).unwrap_or(u64::MAX);
-    for n in &mut nodes {
-        n.start(now_us());
+    for (node, port) in nodes.iter_mut().zip(&ports) {
+        node.start(now_us());
+        while let Some(frame) = node.poll(now_us()) {
+            port.send(frame);
+        }
     }
+    let _ = booted.send(());
     while !stop.load(Ordering::Relaxed) {
         let started = Instant::now();
         let mut busy = false;
