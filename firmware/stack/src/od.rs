@@ -195,6 +195,10 @@ impl EntryInfo {
 
     /// Whether `data` fits this entry: length and value, whoever writes it.
     pub fn check_data(&self, data: &[u8]) -> Result<(), SdoAbort> {
+        // The common case first: full length, no limits, not a BOOLEAN.
+        if data.len() == usize::from(self.size) && self.limits.is_none() && self.data_type != DataType::Boolean {
+            return Ok(());
+        }
         self.check_length(data.len())?;
         self.check_value(data)
     }

@@ -124,6 +124,8 @@ pub struct Core<D, S, const P: usize> {
     tpdos: Vec<Tpdo, P>,
     /// A Bloom filter of the objects valid TPDOs map: most writes skip the TPDO scan.
     tpdo_mapped: u64,
+    /// An RPDO length error is active (cleared by the next correct RPDO).
+    rpdo_length_error: bool,
     bus: BusState,
     bus_off_since: Option<u64>,
 }
@@ -167,6 +169,7 @@ impl<D: Dictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N,
             rpdos: Vec::new(),
             tpdos: Vec::new(),
             tpdo_mapped: 0,
+            rpdo_length_error: false,
             bus: BusState::Active,
             bus_off_since: None,
         };
@@ -366,6 +369,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         // A store that cannot be read leaves the defaults: the node must still boot.
         let _ = self.store.load(&mut self.od, area);
         self.emcy.reset();
+        self.rpdo_length_error = false;
         self.tx.clear();
         self.guarding.reset();
         self.state = NmtState::PreOperational;

@@ -12,11 +12,14 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         let Some(r) = self.rpdos.get(i).copied() else { return };
         if data.len() < usize::from(r.mapping.len()) || r.mapping.is_empty() {
             // CiA 301: a PDO shorter than its mapping is not processed.
+            self.rpdo_length_error = true;
             self.raise_event(EmcyEvent::RpdoLength);
             return;
         }
         // A PDO of the right length ends the length error.
-        self.clear_event(EmcyEvent::RpdoLength);
+        if core::mem::take(&mut self.rpdo_length_error) {
+            self.clear_event(EmcyEvent::RpdoLength);
+        }
         let now = self.now_us;
         if let Some(slot) = self.rpdos.get_mut(i)
             && slot.received(now)
