@@ -25,8 +25,6 @@ pub trait SimNode: Send {
     fn on_bus_state(&mut self, bus: BusState, now_us: u64);
     fn take_event(&mut self) -> Option<NodeEvent>;
     fn trigger_tpdo(&mut self, number: u16);
-    /// Static RAM of the node (its `size_of`).
-    fn ram_bytes(&self) -> usize;
     /// CiA 303-3 indicator states.
     fn leds(&self) -> coforge_stack::leds::Leds;
 }
@@ -74,9 +72,6 @@ where
     fn trigger_tpdo(&mut self, number: u16) {
         Node::trigger_tpdo(self, number);
     }
-    fn ram_bytes(&self) -> usize {
-        core::mem::size_of::<Self>()
-    }
     fn leds(&self) -> coforge_stack::leds::Leds {
         Node::leds(self)
     }
@@ -99,8 +94,6 @@ type Build = fn(Option<&str>, u8, MemStorage) -> Result<Box<dyn SimNode>, String
 #[derive(Debug, Clone, Copy)]
 pub struct DeviceKind {
     pub name: &'static str,
-    /// Mode names from the spec (the first is the default).
-    pub modes: fn() -> Vec<&'static str>,
     build: Build,
     persistent_size: usize,
 }
@@ -109,7 +102,6 @@ macro_rules! device_kind {
     ($krate:ident) => {
         DeviceKind {
             name: stringify!($krate),
-            modes: || $krate::Mode::ALL.iter().map(|m| m.name()).collect(),
             build: |mode, node_id, storage| {
                 let mode = match mode {
                     None => $krate::Mode::ALL[0],

@@ -19,13 +19,11 @@ pub struct MemStorage {
     bytes: Vec<u8>,
     /// Written through at the same offsets, so a save costs what it writes, not the file.
     file: Option<File>,
-    /// Writes so far, for tests that count them.
-    pub writes: u64,
 }
 
 impl MemStorage {
     pub fn new(capacity: usize) -> Self {
-        MemStorage { bytes: vec![0xFF; capacity], file: None, writes: 0 }
+        MemStorage { bytes: vec![0xFF; capacity], file: None }
     }
 
     /// Backed by `path`: loaded from it if it exists, written through on every write.
@@ -38,16 +36,7 @@ impl MemStorage {
         bytes.resize(capacity, 0xFF);
         let mut file = std::fs::OpenOptions::new().create(true).truncate(false).write(true).open(path)?;
         file.write_all(&bytes)?;
-        Ok(MemStorage { bytes, file: Some(file), writes: 0 })
-    }
-
-    pub fn bytes(&self) -> &[u8] {
-        &self.bytes
-    }
-
-    /// Direct access, for tests that corrupt the image.
-    pub fn bytes_mut(&mut self) -> &mut [u8] {
-        &mut self.bytes
+        Ok(MemStorage { bytes, file: Some(file) })
     }
 
     fn range(&self, offset: u32, len: usize) -> Result<std::ops::Range<usize>, StorageError> {
@@ -81,7 +70,6 @@ impl Storage for MemStorage {
     fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), StorageError> {
         let r = self.range(offset, bytes.len())?;
         self.bytes.get_mut(r).ok_or(StorageError::OutOfBounds)?.copy_from_slice(bytes);
-        self.writes += 1;
         if let Some(file) = &mut self.file {
             file.seek(SeekFrom::Start(u64::from(offset))).and_then(|_| file.write_all(bytes)).map_err(|e| StorageError::File(e.to_string()))?;
         }

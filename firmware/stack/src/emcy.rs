@@ -148,10 +148,6 @@ impl EmcyProducer {
         self.last_sent_us = Some(now_us);
         Some(frame)
     }
-
-    pub fn pending(&self) -> bool {
-        !self.queue.is_empty()
-    }
 }
 
 #[cfg(test)]

@@ -3,92 +3,14 @@
 //! server state, which must never panic and only ever abort with a CiA 301 code.
 
 use coforge_link::crc::{Crc16, XMODEM};
-use coforge_stack::od::{ReadLen, SdoAbort};
-use coforge_stack::sdo::{SdoServer, SdoTarget};
+mod common;
 
-const U32: u16 = 0x2000;
-const U8_RO: u16 = 0x2001;
-const STRING: u16 = 0x2002;
-const DOMAIN: u16 = 0x2003;
+use coforge_stack::od::SdoAbort;
+use coforge_stack::sdo::SdoServer;
+use common::{DOMAIN, Dict, STRING, U8_RO, U32};
 
 /// The server's buffer: smaller than the domain, so oversized downloads can be tried.
 const N: usize = 64;
-
-/// One object at sub-index 0: up to 200 bytes.
-#[derive(Debug, Clone, PartialEq)]
-struct Entry {
-    index: u16,
-    writable: bool,
-    /// The value must have exactly `max` bytes (an integer), else up to `max`.
-    fixed: bool,
-    max: usize,
-    len: usize,
-    data: [u8; 200],
-}
-
-impl Entry {
-    fn new(index: u16, writable: bool, fixed: bool, max: usize, value: &[u8]) -> Entry {
-        let mut data = [0; 200];
-        data[..value.len()].copy_from_slice(value);
-        Entry { index, writable, fixed, max, len: value.len(), data }
-    }
-}
-
-/// A u32 rw, a u8 ro, a 40-byte rw string and a 200-byte rw domain; counts writes.
-#[derive(Debug, Clone, PartialEq)]
-struct Dict {
-    entries: [Entry; 4],
-    writes: usize,
-}
-
-impl Dict {
-    fn new() -> Dict {
-        let domain: Vec<u8> = (0..100).map(|i| (i * 7 + 3) as u8).collect();
-        Dict {
-            entries: [
-                Entry::new(U32, true, true, 4, &0x1234_5678_u32.to_le_bytes()),
-                Entry::new(U8_RO, false, true, 1, &[0x5A]),
-                Entry::new(STRING, true, false, 40, b"coforge sdo string!"),
-                Entry::new(DOMAIN, true, false, 200, &domain),
-            ],
-            writes: 0,
-        }
-    }
-
-    fn entry(&mut self, index: u16, sub: u8) -> Result<&mut Entry, SdoAbort> {
-        let entry = self.entries.iter_mut().find(|e| e.index == index).ok_or(SdoAbort::NoObject)?;
-        if sub == 0 { Ok(entry) } else { Err(SdoAbort::NoSubIndex) }
-    }
-}
-
-impl SdoTarget for Dict {
-    fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
-        let e = self.entry(index, sub)?;
-        let rest = e.data[..e.len].get(offset..).ok_or(SdoAbort::LengthTooHigh)?;
-        let copied = rest.len().min(buf.len());
-        buf[..copied].copy_from_slice(&rest[..copied]);
-        Ok(ReadLen { copied, total: e.len })
-    }
-
-    fn check_download(&mut self, index: u16, sub: u8, size: Option<usize>) -> Result<(), SdoAbort> {
-        let e = self.entry(index, sub)?;
-        match size {
-            _ if !e.writable => Err(SdoAbort::ReadOnly),
-            Some(size) if size > e.max => Err(SdoAbort::LengthTooHigh),
-            Some(size) if e.fixed && size < e.max => Err(SdoAbort::LengthTooLow),
-            _ => Ok(()),
-        }
-    }
-
-    fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
-        self.check_download(index, sub, Some(data.len()))?;
-        let e = self.entry(index, sub)?;
-        e.data[..data.len()].copy_from_slice(data);
-        e.len = data.len();
-        self.writes += 1;
-        Ok(())
-    }
-}
 
 /// What a case does, in order.
 #[derive(Debug, Clone)]

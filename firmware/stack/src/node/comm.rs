@@ -11,9 +11,10 @@
 //!   more producers than the node can monitor: 0604 0047h.
 
 use super::Core;
-use super::target::le_u32;
+use super::le_u32;
 use crate::heartbeat::{Consumer, MAX_CONSUMED};
 use crate::od::{Dictionary, SdoAbort, Side};
+use crate::pdo::slot::mapping_words;
 use crate::pdo::{COB_EXTENDED, COB_INVALID, Dir, Mapping, mapping::check_entry, restricted_cob_id};
 use crate::store::ParamStore;
 
@@ -77,16 +78,8 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             return Err(SdoAbort::DataTransferState);
         }
         if sub == 0 {
-            let count = value.min(255) as u8;
-            let mut words = [0_u32; 8];
-            if usize::from(count) > words.len() {
-                return Err(SdoAbort::PdoTooLong);
-            }
-            for (s, w) in (1..=count).zip(words.iter_mut()) {
-                self.od.entry(index, s).map_err(|_| SdoAbort::InvalidValue)?;
-                *w = self.current(index, s);
-            }
-            Mapping::check(&self.od, words.get(..usize::from(count)).unwrap_or(&[]), dir)?;
+            let (words, n) = mapping_words(&mut self.od, index, value)?;
+            Mapping::check(&self.od, words.get(..n).unwrap_or(&[]), dir)?;
             return Ok(());
         }
         if self.current(index, 0) != 0 {

@@ -36,7 +36,12 @@ use heapless::{Deque, Vec};
 pub fn read_u32(od: &mut impl ObjectDictionary, index: u16, sub: u8) -> Option<u32> {
     let mut buf = [0_u8; 4];
     let n = od.read(index, sub, 0, &mut buf, Side::Device).ok()?.copied;
-    Some(buf.iter().take(n).rev().fold(0_u32, |acc, &b| acc << 8 | u32::from(b)))
+    Some(le_u32(buf.get(..n).unwrap_or(&buf)))
+}
+
+/// Up to 4 little-endian bytes as a number (shorter values zero-extended).
+pub(crate) fn le_u32(data: &[u8]) -> u32 {
+    data.iter().take(4).rev().fold(0, |acc, &b| acc << 8 | u32::from(b))
 }
 
 /// How a device's node differs from a plain CiA 301 slave.

@@ -56,14 +56,19 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         self.reload_services(now_us);
         self.rpdos.clear();
         self.tpdos.clear();
-        for offset in 0..0x200 {
-            if self.rpdos.len() < P && self.od.entry(Dir::Rx.comm_base() + offset, 1).is_ok() {
-                let r = Rpdo::load(&mut self.od, offset);
-                let _ = self.rpdos.push(r);
-            }
-            if self.tpdos.len() < P && self.od.entry(Dir::Tx.comm_base() + offset, 1).is_ok() {
-                let t = Tpdo::load(&mut self.od, offset, now_us);
-                let _ = self.tpdos.push(t);
+        // Every PDO communication object with a COB-ID (sub 1), in index order.
+        let entries = self.od.entries();
+        for e in entries.iter().filter(|e| e.covers(1)) {
+            match Dir::of_index(e.index) {
+                Some((Dir::Rx, false, offset)) if self.rpdos.len() < P => {
+                    let r = Rpdo::load(&mut self.od, offset);
+                    let _ = self.rpdos.push(r);
+                }
+                Some((Dir::Tx, false, offset)) if self.tpdos.len() < P => {
+                    let t = Tpdo::load(&mut self.od, offset, now_us);
+                    let _ = self.tpdos.push(t);
+                }
+                _ => {}
             }
         }
         self.refresh_tpdo_filter();

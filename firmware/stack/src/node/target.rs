@@ -121,11 +121,6 @@ impl<D: Dictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, P> {
     }
 }
 
-/// The value a write would leave in a 4-byte entry.
-pub(super) fn le_u32(data: &[u8]) -> u32 {
-    data.iter().take(4).rev().fold(0, |acc, &b| acc << 8 | u32::from(b))
-}
-
 impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     pub(super) fn current(&mut self, index: u16, sub: u8) -> u32 {
         read_u32(&mut self.od, index, sub).unwrap_or(0)

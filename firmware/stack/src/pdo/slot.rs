@@ -2,7 +2,7 @@
 //! mapping, and the timers and buffers its transmission type needs.
 
 use super::{COB_EXTENDED, COB_INVALID, COB_NO_RTR, Dir, Mapping};
-use crate::od::ObjectDictionary;
+use crate::od::{ObjectDictionary, SdoAbort};
 
 /// Communication parameters as read from 14xxh/18xxh.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -55,15 +55,26 @@ impl Comm {
     }
 }
 
+/// The first `count` entries (subs 1..=count) of mapping object `index`: `PdoTooLong` if
+/// more than a frame can carry, `InvalidValue` if the object has fewer sub-indices.
+pub fn mapping_words(od: &mut impl ObjectDictionary, index: u16, count: u32) -> Result<([u32; 8], usize), SdoAbort> {
+    let mut words = [0_u32; 8];
+    let count = usize::try_from(count).unwrap_or(usize::MAX);
+    if count > words.len() {
+        return Err(SdoAbort::PdoTooLong);
+    }
+    for (sub, w) in (1..=8_u8).zip(words.iter_mut()).take(count) {
+        od.entry(index, sub).map_err(|_| SdoAbort::InvalidValue)?;
+        *w = crate::node::read_u32(od, index, sub).unwrap_or(0);
+    }
+    Ok((words, count))
+}
+
 /// Reads a mapping object (sub 0 = count, subs 1..=count the entries) and checks it; an
 /// invalid stored mapping counts as empty.
 pub fn read_mapping(od: &mut impl ObjectDictionary, index: u16, dir: Dir) -> Mapping {
-    let count = crate::node::read_u32(od, index, 0).unwrap_or(0).min(8) as u8;
-    let mut words = [0_u32; 8];
-    for (sub, w) in (1..=count).zip(words.iter_mut()) {
-        *w = crate::node::read_u32(od, index, sub).unwrap_or(0);
-    }
-    Mapping::check(od, words.get(..usize::from(count)).unwrap_or(&[]), dir).unwrap_or_default()
+    let count = crate::node::read_u32(od, index, 0).unwrap_or(0);
+    mapping_words(od, index, count).and_then(|(words, n)| Mapping::check(od, words.get(..n).unwrap_or(&[]), dir)).unwrap_or_default()
 }
 
 /// A receive PDO.
