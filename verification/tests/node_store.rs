@@ -14,10 +14,10 @@ fn guard_time(od: &mut Od<NoAppObjects>) -> u16 {
     u16::from_le_bytes(buf)
 }
 
-fn saved_block() -> BlockStore<RamStorage<1024>> {
+fn saved_block() -> BlockStore<RamStorage<2048>> {
     let mut od = Od::new(Mode::Mixed, 5, NoAppObjects);
     od.write(0x100C, 0, &500_u16.to_le_bytes(), Side::Bus, &PREOP).expect("writable in pre-operational");
-    let mut store = BlockStore::new(RamStorage([0xFF; 1024]), 0);
+    let mut store = BlockStore::new(RamStorage([0xFF; 2048]), 0);
     store.save(&od, Area::ALL).expect("fits");
     store
 }
@@ -47,10 +47,93 @@ fn every_corrupted_byte_falls_back_to_defaults() {
 #[test]
 fn erase_and_a_too_small_device_are_handled() {
     let mut store = saved_block();
-    store.erase().expect("writable");
+    store.erase(&Od::new(Mode::Mixed, 5, NoAppObjects)).expect("writable");
     let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
     assert_eq!(store.load(&mut fresh, Area::ALL), Ok(false), "1011h: nothing valid stored");
     let od = Od::new(Mode::Mixed, 5, NoAppObjects);
     let mut tiny = BlockStore::new(RamStorage([0xFF; 16]), 0);
     assert!(tiny.save(&od, Area::ALL).is_err(), "a block larger than the device is refused");
+}
+
+/// A storage device that fails every write after `budget` of them: a save torn at any point.
+#[derive(Debug)]
+struct Torn {
+    image: RamStorage<2048>,
+    budget: usize,
+}
+
+impl embedded_storage::ReadStorage for Torn {
+    type Error = ();
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), ()> {
+        self.image.read(offset, bytes)
+    }
+    fn capacity(&self) -> usize {
+        self.image.capacity()
+    }
+}
+
+impl embedded_storage::Storage for Torn {
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), ()> {
+        if self.budget == 0 {
+            return Err(());
+        }
+        self.budget -= 1;
+        self.image.write(offset, bytes)
+    }
+}
+
+fn od_with_guard_time(ms: u16) -> Od<NoAppObjects> {
+    let mut od = Od::new(Mode::Mixed, 5, NoAppObjects);
+    od.write(0x100C, 0, &ms.to_le_bytes(), Side::Bus, &PREOP).expect("writable in pre-operational");
+    od
+}
+
+#[test]
+fn a_save_torn_at_any_write_keeps_the_previous_block() {
+    let image = saved_block().into_inner();
+    let mut completed = false;
+    for budget in 0..2000 {
+        let mut store = BlockStore::new(Torn { image: RamStorage(image.0), budget }, 0);
+        let result = store.save(&od_with_guard_time(700), Area::ALL);
+        let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
+        assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true), "a block is always there (budget {budget})");
+        let expected = if result.is_ok() { 700 } else { 500 };
+        assert_eq!(guard_time(&mut fresh), expected, "budget {budget}: {result:?}");
+        if result.is_ok() {
+            completed = true;
+            break;
+        }
+    }
+    assert!(completed, "a save completes with enough writes");
+}
+
+#[test]
+fn the_newest_block_wins_and_a_corrupt_newest_falls_back_to_the_previous() {
+    let mut store = saved_block();
+    store.save(&od_with_guard_time(700), Area::ALL).expect("fits");
+    store.save(&od_with_guard_time(900), Area::ALL).expect("fits");
+    let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
+    assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true));
+    assert_eq!(guard_time(&mut fresh), 900, "three saves: the last one wins");
+    // The third save went to slot 0 again; corrupt its data.
+    let mut image = store.into_inner();
+    image.0[12] ^= 0xFF;
+    let mut store = BlockStore::new(image, 0);
+    let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
+    assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true));
+    assert_eq!(guard_time(&mut fresh), 700, "the previous block");
+}
+
+#[test]
+fn saving_one_area_keeps_the_others_from_the_previous_block() {
+    let mut store = saved_block();
+    let mut od = od_with_guard_time(700);
+    od.write(0x2180, 0, &2000_u16.to_le_bytes(), Side::Bus, &PREOP).expect("manufacturer area");
+    store.save(&od, Area::MANUFACTURER).expect("fits");
+    let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
+    assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true));
+    assert_eq!(guard_time(&mut fresh), 500, "communication area as saved before");
+    let mut buf = [0; 2];
+    fresh.read(0x2180, 0, 0, &mut buf, Side::Device).expect("2180h exists");
+    assert_eq!(u16::from_le_bytes(buf), 2000, "manufacturer area saved now");
 }

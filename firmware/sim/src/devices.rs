@@ -122,9 +122,6 @@ macro_rules! device_kind {
 /// Every device, by crate name.
 pub const DEVICES: [DeviceKind; 4] = [device_kind!(co401memory1), device_kind!(co401gw1), device_kind!(cr3101), device_kind!(canopenia)];
 
-/// Bytes of parameter storage a device needs: the block header plus its persistent entries.
-const HEADER: usize = 12;
-
 impl DeviceKind {
     pub fn find(name: &str) -> Result<DeviceKind, String> {
         DEVICES.into_iter().find(|d| d.name == name).ok_or_else(|| {
@@ -138,7 +135,7 @@ impl DeviceKind {
         if !(1..=127).contains(&node_id) {
             return Err(format!("node-ID {node_id} is outside 1..=127"));
         }
-        let capacity = HEADER + self.persistent_size;
+        let capacity = BlockStore::<MemStorage>::capacity_for(self.persistent_size);
         let storage = match store {
             StoreAt::Memory => MemStorage::new(capacity),
             StoreAt::File(path) => MemStorage::with_file(capacity, path).map_err(|e| format!("{}: {e}", path.display()))?,

@@ -1,11 +1,12 @@
 //! The parameter block of 1010h/1011h on any `embedded-storage` device (EEPROM, flash
 //! emulation, a file on a PC).
 //!
-//! Layout at `base`: magic "CFG1", block length (u32 LE), CRC-16/XMODEM of the data (u16 LE),
-//! two reserved bytes, then the data as [`Dictionary::save_area`] lays it out. A block whose
-//! magic, length or CRC does not match is ignored, so a torn or corrupt store falls back to
-//! the spec defaults instead of loading garbage. Saving invalidates the header first and
-//! writes it last.
+//! Two slots alternate, each a header (magic "CFG1", block length u32 LE, CRC-16/XMODEM u16
+//! LE, sequence number u16 LE) and the data as [`Dictionary::save_area`] lays it out. The CRC
+//! covers length, sequence and data. A save writes the slot that does not hold the newest
+//! valid block, and its header last, so a save torn by a reset or a storage error leaves the
+//! previous block in place. A slot whose magic, length or CRC does not match is ignored; with
+//! no valid slot the node keeps the spec defaults instead of loading garbage.
 
 use crate::od::{Area, Dictionary};
 use coforge_link::crc::{Crc16, XMODEM};
@@ -31,7 +32,7 @@ pub trait ParamStore {
     /// Loads the stored entries of `area` into `od`; `Ok(false)` if nothing valid is stored.
     fn load(&mut self, od: &mut dyn DictionaryImage, area: Area) -> Result<bool, StoreError>;
     /// Invalidates the stored block, so the next reset uses the spec defaults (1011h).
-    fn erase(&mut self) -> Result<(), StoreError>;
+    fn erase(&mut self, od: &dyn DictionaryImage) -> Result<(), StoreError>;
 }
 
 /// The object-safe part of [`Dictionary`] that storing needs.
@@ -64,7 +65,7 @@ impl ParamStore for NoStore {
     fn load(&mut self, _: &mut dyn DictionaryImage, _: Area) -> Result<bool, StoreError> {
         Ok(false)
     }
-    fn erase(&mut self) -> Result<(), StoreError> {
+    fn erase(&mut self, _: &dyn DictionaryImage) -> Result<(), StoreError> {
         Ok(())
     }
 }
@@ -76,9 +77,21 @@ pub struct BlockStore<S> {
     base: u32,
 }
 
+/// The slot holding the newest valid block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Newest {
+    slot: u32,
+    seq: u16,
+}
+
 impl<S: Storage> BlockStore<S> {
     pub const fn new(storage: S, base: u32) -> Self {
         BlockStore { storage, base }
+    }
+
+    /// Bytes of storage the two slots of a `len`-byte block take.
+    pub const fn capacity_for(len: usize) -> usize {
+        2 * (HEADER as usize + len)
     }
 
     pub fn storage(&self) -> &S {
@@ -89,84 +102,140 @@ impl<S: Storage> BlockStore<S> {
         self.storage
     }
 
-    fn data_at(&self, offset: usize) -> Option<u32> {
-        self.base.checked_add(HEADER)?.checked_add(u32::try_from(offset).ok()?)
+    /// Where slot 0 or 1 of a `len`-byte block starts.
+    fn slot_at(&self, slot: u32, len: usize) -> Result<u32, StoreError> {
+        let size = HEADER.checked_add(u32::try_from(len).map_err(|_| StoreError::TooSmall)?).ok_or(StoreError::TooSmall)?;
+        self.base.checked_add(slot * size).ok_or(StoreError::TooSmall)
     }
 
-    /// Magic, length and CRC; a header whose reserved bytes are not zero reads as no magic.
-    fn header(&mut self) -> Result<([u8; 4], u32, u16), StoreError> {
+    /// Magic, length, CRC and sequence number of the slot at `at`.
+    fn header(&mut self, at: u32) -> Result<([u8; 4], u32, u16, u16), StoreError> {
         let mut h = [0_u8; HEADER as usize];
-        self.storage.read(self.base, &mut h).map_err(|_| StoreError::Device)?;
-        let [m0, m1, m2, m3, l0, l1, l2, l3, c0, c1, r0, r1] = h;
-        let magic = if [r0, r1] == [0, 0] { [m0, m1, m2, m3] } else { [0; 4] };
-        Ok((magic, u32::from_le_bytes([l0, l1, l2, l3]), u16::from_le_bytes([c0, c1])))
+        self.storage.read(at, &mut h).map_err(|_| StoreError::Device)?;
+        let [m0, m1, m2, m3, l0, l1, l2, l3, c0, c1, s0, s1] = h;
+        Ok(([m0, m1, m2, m3], u32::from_le_bytes([l0, l1, l2, l3]), u16::from_le_bytes([c0, c1]), u16::from_le_bytes([s0, s1])))
     }
 
-    /// CRC of `len` data bytes, read back in small chunks.
-    fn data_crc(&mut self, len: usize) -> Result<u16, StoreError> {
-        let mut crc = CRC.start();
+    /// CRC of length, sequence number and the `len` data bytes of the slot at `at`, read
+    /// back in small chunks.
+    fn slot_crc(&mut self, at: u32, len: usize, seq: u16) -> Result<u16, StoreError> {
+        let len32 = u32::try_from(len).map_err(|_| StoreError::TooSmall)?;
+        let mut crc = CRC.update(CRC.update(CRC.start(), &len32.to_le_bytes()), &seq.to_le_bytes());
         let mut chunk = [0_u8; 32];
-        let mut at = 0;
-        while at < len {
-            let n = (len - at).min(chunk.len());
+        let mut done = 0;
+        while done < len {
+            let n = (len - done).min(chunk.len());
             let buf = chunk.get_mut(..n).ok_or(StoreError::TooSmall)?;
-            self.storage.read(self.data_at(at).ok_or(StoreError::TooSmall)?, buf).map_err(|_| StoreError::Device)?;
+            self.storage.read(data_at(at, done)?, buf).map_err(|_| StoreError::Device)?;
             crc = CRC.update(crc, buf);
-            at += n;
+            done += n;
         }
         Ok(CRC.finish(crc))
     }
 
-    /// Whether a block of `len` bytes with a matching CRC is stored.
-    pub fn is_valid(&mut self, len: usize) -> Result<bool, StoreError> {
-        let (magic, stored_len, crc) = self.header()?;
+    /// The sequence number of the slot's block, if it holds a valid `len`-byte block.
+    fn valid_seq(&mut self, slot: u32, len: usize) -> Result<Option<u16>, StoreError> {
+        let at = self.slot_at(slot, len)?;
+        let (magic, stored_len, crc, seq) = self.header(at)?;
         if magic != MAGIC || usize::try_from(stored_len).ok() != Some(len) {
-            return Ok(false);
+            return Ok(None);
         }
-        Ok(self.data_crc(len)? == crc)
+        Ok((self.slot_crc(at, len, seq)? == crc).then_some(seq))
     }
 
-    fn write_header(&mut self, magic: [u8; 4], len: usize, crc: u16) -> Result<(), StoreError> {
+    /// The slot with the newest valid block (sequence numbers compared with wrap-around).
+    fn newest(&mut self, len: usize) -> Result<Option<Newest>, StoreError> {
+        let a = self.valid_seq(0, len)?.map(|seq| Newest { slot: 0, seq });
+        let b = self.valid_seq(1, len)?.map(|seq| Newest { slot: 1, seq });
+        Ok(match (a, b) {
+            (Some(a), Some(b)) => Some(if b.seq.wrapping_sub(a.seq) as i16 > 0 { b } else { a }),
+            (a, b) => a.or(b),
+        })
+    }
+
+    /// Whether a valid block of `len` bytes is stored.
+    pub fn is_valid(&mut self, len: usize) -> Result<bool, StoreError> {
+        Ok(self.newest(len)?.is_some())
+    }
+
+    fn write_header(&mut self, at: u32, magic: [u8; 4], len: usize, crc: u16, seq: u16) -> Result<(), StoreError> {
         let [l0, l1, l2, l3] = u32::try_from(len).map_err(|_| StoreError::TooSmall)?.to_le_bytes();
         let [c0, c1] = crc.to_le_bytes();
+        let [s0, s1] = seq.to_le_bytes();
         let [m0, m1, m2, m3] = magic;
-        self.storage.write(self.base, &[m0, m1, m2, m3, l0, l1, l2, l3, c0, c1, 0, 0]).map_err(|_| StoreError::Device)
+        self.storage.write(at, &[m0, m1, m2, m3, l0, l1, l2, l3, c0, c1, s0, s1]).map_err(|_| StoreError::Device)
     }
+
+    /// Copies the data of one slot into the other, in small chunks.
+    fn copy_data(&mut self, from: u32, to: u32, len: usize) -> Result<(), StoreError> {
+        let mut chunk = [0_u8; 32];
+        let mut done = 0;
+        while done < len {
+            let n = (len - done).min(chunk.len());
+            let buf = chunk.get_mut(..n).ok_or(StoreError::TooSmall)?;
+            self.storage.read(data_at(from, done)?, buf).map_err(|_| StoreError::Device)?;
+            self.storage.write(data_at(to, done)?, buf).map_err(|_| StoreError::Device)?;
+            done += n;
+        }
+        Ok(())
+    }
+}
+
+/// Where byte `offset` of the data of the slot at `slot_at` lives.
+fn data_at(slot_at: u32, offset: usize) -> Result<u32, StoreError> {
+    slot_at.checked_add(HEADER).and_then(|d| d.checked_add(u32::try_from(offset).ok()?)).ok_or(StoreError::TooSmall)
 }
 
 impl<S: Storage> ParamStore for BlockStore<S> {
     fn save(&mut self, od: &dyn DictionaryImage, area: Area) -> Result<(), StoreError> {
         let len = od.size();
-        let end = self.data_at(len).ok_or(StoreError::TooSmall)?;
-        if usize::try_from(end).map_err(|_| StoreError::TooSmall)? > self.storage.capacity() {
+        let end = usize::try_from(self.slot_at(2, len)?).map_err(|_| StoreError::TooSmall)?;
+        if end > self.storage.capacity() {
             return Err(StoreError::TooSmall);
         }
-        // Without a valid block there is nothing to keep: store every area.
-        let area = if self.is_valid(len)? { area } else { Area::ALL };
-        self.write_header([0; 4], len, 0)?;
+        let newest = self.newest(len)?;
+        let target_slot = newest.map_or(0, |n| 1 - n.slot);
+        let target = self.slot_at(target_slot, len)?;
+        // The newest block stays valid until the new header is written.
+        self.write_header(target, [0; 4], len, 0, 0)?;
+        let area = match newest {
+            // Only some areas change: start from the newest block's contents.
+            Some(n) if area != Area::ALL => {
+                let from = self.slot_at(n.slot, len)?;
+                self.copy_data(from, target, len)?;
+                area
+            }
+            // Without a valid block there is nothing to keep: store every area.
+            _ => Area::ALL,
+        };
         let mut failed = false;
         let written = od.save_area(area, &mut |offset, image| {
-            let ok = self.data_at(offset).is_some_and(|at| self.storage.write(at, image).is_ok());
+            let ok = data_at(target, offset).is_ok_and(|at| self.storage.write(at, image).is_ok());
             failed |= !ok;
             ok
         });
         if !written || failed {
             return Err(StoreError::Device);
         }
-        let crc = self.data_crc(len)?;
-        self.write_header(MAGIC, len, crc)
+        let seq = newest.map_or(1, |n| n.seq.wrapping_add(1));
+        let crc = self.slot_crc(target, len, seq)?;
+        self.write_header(target, MAGIC, len, crc, seq)
     }
 
     fn load(&mut self, od: &mut dyn DictionaryImage, area: Area) -> Result<bool, StoreError> {
         let len = od.size();
-        if !self.is_valid(len)? {
-            return Ok(false);
-        }
-        let loaded = od.load_area(area, &mut |offset, buf| self.data_at(offset).is_some_and(|at| self.storage.read(at, buf).is_ok()));
+        let Some(newest) = self.newest(len)? else { return Ok(false) };
+        let from = self.slot_at(newest.slot, len)?;
+        let loaded = od.load_area(area, &mut |offset, buf| data_at(from, offset).is_ok_and(|at| self.storage.read(at, buf).is_ok()));
         if loaded { Ok(true) } else { Err(StoreError::Device) }
     }
 
-    fn erase(&mut self) -> Result<(), StoreError> {
-        self.write_header([0; 4], 0, 0)
+    fn erase(&mut self, od: &dyn DictionaryImage) -> Result<(), StoreError> {
+        let len = od.size();
+        for slot in [0, 1] {
+            let at = self.slot_at(slot, len)?;
+            self.write_header(at, [0; 4], 0, 0, 0)?;
+        }
+        Ok(())
     }
 }

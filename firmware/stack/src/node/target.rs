@@ -38,7 +38,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             self.store.save(&self.od, area)
         } else if area == crate::od::Area::ALL {
             // Restored defaults take effect at the next reset (CiA 301).
-            self.store.erase()
+            self.store.erase(&self.od)
         } else {
             // One area of a single stored block: store that area's defaults.
             self.od.reset_area(area, self.node_id);
