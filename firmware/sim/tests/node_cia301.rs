@@ -291,3 +291,26 @@ fn bus_off_restart_and_return_emergency() {
     assert_eq!(emcy_frames(&mut bus), vec![[0x00, 0x81, 0x01, 0, 0, 0, 0, 0x40]], "spec can_warning emergency");
     assert_eq!(bus.nodes[0].leds().error, LedState::SingleFlash);
 }
+
+#[test]
+fn timers_near_the_end_of_the_clock_do_not_overflow() {
+    use coforge_stack::od::Side;
+    let mut n = node("co401gw1");
+    let t = u64::MAX - 1_000;
+    n.start(t);
+    n.write(0x1017, 0, &100_u16.to_le_bytes(), Side::Bus).unwrap();
+    n.write(0x1800, 5, &10_u16.to_le_bytes(), Side::Bus).unwrap();
+    n.write(0x1400, 5, &10_u16.to_le_bytes(), Side::Bus).unwrap();
+    n.on_frame(&frame(0x000, &[0x01, ID]), t);
+    n.on_frame(&frame(0x205, &[0; 8]), t);
+    n.trigger_tpdo(1);
+    let mut sent = 0;
+    // Deadlines saturate at u64::MAX (584 000 years of microseconds) instead of overflowing.
+    for now in [t, t + 500] {
+        while n.poll(now).is_some() {
+            sent += 1;
+        }
+    }
+    assert!(sent >= 2, "boot-up and the TPDO go out ({sent})");
+    assert_eq!(n.state(), NmtState::Operational);
+}

@@ -7,6 +7,7 @@
 //!                  write/raise/trigger_tpdo (device code)
 //! ```
 //! All times are microseconds from an arbitrary epoch; the node never reads a clock itself.
+//! Deadlines saturate at `u64::MAX` (584 000 years) rather than overflow.
 //!
 //! - `target`: writes with their side effects, and the SDO server's view of the node;
 //! - `comm`: the CiA 301 rules for writes to communication objects (PDO remapping and more);
