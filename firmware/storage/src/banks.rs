@@ -1,0 +1,374 @@
+//! The two mirrored banks over any two `embedded-storage` devices.
+
+use crate::record::{RECORD, Record, offset};
+use crate::resolve::{CopyState, Verdict, resolve};
+use crate::status::BankStatus;
+use embedded_storage::Storage;
+
+/// Why a read or write of the banks failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Error {
+    /// The address range is outside the data area.
+    OutOfRange,
+    /// Neither bank holds a valid copy of this block.
+    Lost { block: usize },
+    /// A bank did not answer. Reads fall back to the other bank; writes are refused, because
+    /// a write with a single bank could tear the only copy.
+    Access,
+}
+
+/// One copy of a block as read from a bank.
+#[derive(Debug, Clone, Copy)]
+struct Copy<const BLOCK: usize> {
+    data: [u8; BLOCK],
+    record: Record,
+    state: CopyState,
+}
+
+impl<const BLOCK: usize> Copy<BLOCK> {
+    /// What a bank holds after committing `data` as `seq`.
+    fn committed(data: [u8; BLOCK], seq: u8) -> Self {
+        Copy { data, record: Record::committed(&data, seq), state: CopyState::Valid(seq) }
+    }
+}
+
+/// A block's contents once both banks agree on them.
+#[derive(Debug, Clone, Copy)]
+struct Settled<const BLOCK: usize> {
+    data: [u8; BLOCK],
+    seq: u8,
+}
+
+/// `BLOCKS` blocks of `BLOCK` bytes, mirrored in two banks (index 0 = bank 1, written first).
+#[derive(Debug)]
+pub struct MirroredBanks<S, const BLOCKS: usize, const BLOCK: usize> {
+    banks: [S; 2],
+    status: [BankStatus; 2],
+    /// The sum of each block's data bytes in each bank as last read or written: 5C00h
+    /// without rereading the EEPROM, and corrected whenever a load finds other bytes.
+    block_sums: [[u16; BLOCKS]; 2],
+    lost: [bool; BLOCKS],
+    scrub_at: usize,
+}
+
+impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCKS, BLOCK> {
+    /// Bytes of one block's slot in a bank: data, then the commit record.
+    pub const SLOT: usize = BLOCK + RECORD;
+    /// Bytes each bank's EEPROM must provide.
+    pub const BANK_SIZE: usize = BLOCKS * Self::SLOT;
+    /// The user-visible data bytes.
+    pub const DATA_SIZE: usize = BLOCKS * BLOCK;
+    /// Per-block sums are 16-bit: a block may hold at most 257 bytes of 0xFF.
+    const SUM_FITS: () = assert!(BLOCK * 255 <= u16::MAX as usize, "blocks above 257 bytes need wider block sums");
+
+    /// Start-up: checks every block in both banks, repairs what a power cut or corruption
+    /// left behind, and formats the banks if neither holds a single valid block (blank
+    /// EEPROMs). Never fails: what cannot be repaired shows in the status and lost blocks.
+    pub fn mount(banks: [S; 2]) -> Self {
+        let () = Self::SUM_FITS;
+        let mut me = MirroredBanks { banks, status: [BankStatus::default(); 2], block_sums: [[0; BLOCKS]; 2], lost: [false; BLOCKS], scrub_at: 0 };
+        let mut blank = BLOCKS > 0;
+        for block in 0..BLOCKS {
+            let copies = [me.load(0, block), me.load(1, block)];
+            blank &= copies.iter().all(|c| c.state == CopyState::Invalid);
+            let _ = me.settle(block, &copies);
+        }
+        if blank {
+            me.format();
+        }
+        me
+    }
+
+    /// Writes zeros, committed as sequence 0, to every block of both banks.
+    fn format(&mut self) {
+        self.status = [BankStatus(BankStatus::CLEARED); 2];
+        for block in 0..BLOCKS {
+            for bank in 0..2 {
+                let current = self.load(bank, block);
+                if self.write_copy(bank, block, &current, &[0; BLOCK], 0).is_ok() {
+                    self.set_lost(block, false);
+                }
+            }
+        }
+    }
+
+    pub fn banks(&self) -> &[S; 2] {
+        &self.banks
+    }
+
+    /// The raw devices, for fault injection in tests.
+    pub fn banks_mut(&mut self) -> &mut [S; 2] {
+        &mut self.banks
+    }
+
+    pub fn into_banks(self) -> [S; 2] {
+        self.banks
+    }
+
+    /// Status of bank `bank` (0 or 1).
+    pub fn status(&self, bank: usize) -> BankStatus {
+        self.status.get(bank).copied().unwrap_or_default()
+    }
+
+    /// Command 0x91: forget the bank's error flags. Stored data is not touched.
+    pub fn clear_status(&mut self, bank: usize) {
+        if let Some(s) = self.status.get_mut(bank) {
+            *s = BankStatus::default();
+        }
+    }
+
+    /// The 32-bit sum of bank `bank`'s data bytes (5C00h), without reading the EEPROM.
+    pub fn checksum(&self, bank: usize) -> u32 {
+        self.block_sums.get(bank).map_or(0, |sums| sums.iter().map(|&s| u32::from(s)).sum())
+    }
+
+    /// Neither bank holds a valid copy of `block`.
+    pub fn is_lost(&self, block: usize) -> bool {
+        self.lost.get(block).copied().unwrap_or(false)
+    }
+
+    /// Reads `out.len()` data bytes from `addr`, comparing both banks; a block whose copies
+    /// differ is resolved and repaired before its bytes are returned.
+    pub fn read(&mut self, addr: usize, out: &mut [u8]) -> Result<(), Error> {
+        let mut done = 0;
+        for (block, at, n) in Self::chunks(addr, out.len())? {
+            let dst = out.get_mut(done..done + n).ok_or(Error::OutOfRange)?;
+            self.read_in_block(block, at, dst)?;
+            done += n;
+        }
+        Ok(())
+    }
+
+    /// Writes `data` at `addr` to both banks, bank 1 first. Each block commits atomically;
+    /// a write spanning blocks may be cut between them. Writing what is already stored
+    /// costs no EEPROM write.
+    pub fn write(&mut self, addr: usize, data: &[u8]) -> Result<(), Error> {
+        let mut done = 0;
+        for (block, at, n) in Self::chunks(addr, data.len())? {
+            let src = data.get(done..done + n).ok_or(Error::OutOfRange)?;
+            self.write_in_block(block, at, src)?;
+            done += n;
+        }
+        Ok(())
+    }
+
+    /// Checks and repairs one block; call it periodically so corruption in rarely read
+    /// blocks is found while the other bank still holds them.
+    pub fn check_block(&mut self, block: usize) -> Result<(), Error> {
+        if block >= BLOCKS {
+            return Err(Error::OutOfRange);
+        }
+        let copies = [self.load(0, block), self.load(1, block)];
+        self.settle(block, &copies).map(|_| ())
+    }
+
+    /// Checks the next block in turn (a background scrub).
+    pub fn scrub_next(&mut self) -> Result<(), Error> {
+        let block = self.scrub_at;
+        self.scrub_at = if block + 1 >= BLOCKS { 0 } else { block + 1 };
+        self.check_block(block)
+    }
+
+    /// Splits `len` bytes from `addr` into `(block, offset in block, length)` pieces.
+    fn chunks(addr: usize, len: usize) -> Result<impl Iterator<Item = (usize, usize, usize)>, Error> {
+        let end = addr.checked_add(len).filter(|&e| e <= Self::DATA_SIZE).ok_or(Error::OutOfRange)?;
+        let mut pos = addr;
+        Ok(core::iter::from_fn(move || {
+            if pos >= end || BLOCK == 0 {
+                return None;
+            }
+            let (block, at) = (pos / BLOCK, pos % BLOCK);
+            let n = (BLOCK - at).min(end - pos);
+            pos += n;
+            Some((block, at, n))
+        }))
+    }
+
+    fn read_in_block(&mut self, block: usize, at: usize, dst: &mut [u8]) -> Result<(), Error> {
+        if !self.is_lost(block) {
+            let mut other = [0_u8; BLOCK];
+            let other = other.get_mut(..dst.len()).ok_or(Error::OutOfRange)?;
+            let base = Self::slot(block) + at;
+            let a = self.get(0, base, dst);
+            let b = self.get(1, base, other);
+            if a.is_ok() && b.is_ok() && dst == other {
+                return Ok(());
+            }
+        }
+        let copies = [self.load(0, block), self.load(1, block)];
+        let settled = self.settle(block, &copies)?;
+        let src = settled.data.get(at..at + dst.len()).ok_or(Error::OutOfRange)?;
+        dst.copy_from_slice(src);
+        Ok(())
+    }
+
+    fn write_in_block(&mut self, block: usize, at: usize, src: &[u8]) -> Result<(), Error> {
+        let copies = [self.load(0, block), self.load(1, block)];
+        if copies.iter().any(|c| c.state == CopyState::Unreadable) {
+            return Err(Error::Access);
+        }
+        let (old, seq, current) = match self.settle(block, &copies) {
+            Ok(s) => (Some(s.data), s.seq.wrapping_add(1), [Copy::committed(s.data, s.seq); 2]),
+            // Both copies lost: the block starts again from zeros, and the banks say so.
+            Err(Error::Lost { .. }) => {
+                for s in &mut self.status {
+                    s.set(BankStatus::CLEARED);
+                }
+                (None, 0, copies)
+            }
+            Err(e) => return Err(e),
+        };
+        let mut new = old.unwrap_or([0; BLOCK]);
+        new.get_mut(at..at + src.len()).ok_or(Error::OutOfRange)?.copy_from_slice(src);
+        if old == Some(new) {
+            return Ok(());
+        }
+        let [first, second] = current;
+        self.write_copy(0, block, &first, &new, seq)?;
+        self.write_copy(1, block, &second, &new, seq)?;
+        self.set_lost(block, false);
+        Ok(())
+    }
+
+    /// Decides a block from its two copies, repairs the losing bank and records why.
+    fn settle(&mut self, block: usize, copies: &[Copy<BLOCK>; 2]) -> Result<Settled<BLOCK>, Error> {
+        let [a, b] = copies;
+        match resolve(a.state, b.state, a.data == b.data) {
+            Verdict::Agree => {
+                self.set_lost(block, false);
+                Ok(Settled { data: a.data, seq: a.record.seq() })
+            }
+            Verdict::Use { winner, repair, flags } => {
+                let (w, loser, l) = if winner == 0 { (a, 1, b) } else { (b, 0, a) };
+                if let Some(s) = self.status.get_mut(loser) {
+                    s.set(flags);
+                }
+                let seq = w.record.seq();
+                if repair {
+                    // A failed repair leaves the loser invalid; the winner is still intact.
+                    let _ = self.write_copy(loser, block, l, &w.data, seq);
+                }
+                self.set_lost(block, false);
+                Ok(Settled { data: w.data, seq })
+            }
+            Verdict::Lost => {
+                for (s, c) in self.status.iter_mut().zip(copies) {
+                    if c.state == CopyState::Invalid {
+                        s.set(BankStatus::CHECKSUM_ERROR);
+                    }
+                }
+                self.set_lost(block, true);
+                Err(Error::Lost { block })
+            }
+        }
+    }
+
+    /// Turns `current` (what `bank` holds for `block`) into `new` committed as `seq`, in the
+    /// order of [`crate::record`], writing only bytes that change.
+    fn write_copy(&mut self, bank: usize, block: usize, current: &Copy<BLOCK>, new: &[u8; BLOCK], seq: u8) -> Result<(), Error> {
+        let result = self.commit(bank, block, current, new, seq);
+        if result.is_ok() {
+            self.set_block_sum(bank, block, new);
+        } else {
+            // Some bytes may be written: count what the bank now holds, if it answers.
+            let mut now = [0_u8; BLOCK];
+            if self.get(bank, Self::slot(block), &mut now).is_ok() {
+                self.set_block_sum(bank, block, &now);
+            }
+        }
+        result
+    }
+
+    fn commit(&mut self, bank: usize, block: usize, current: &Copy<BLOCK>, new: &[u8; BLOCK], seq: u8) -> Result<(), Error> {
+        let base = Self::slot(block);
+        let mark = current.record.invalidating_mark(seq);
+        if current.record.begin != mark {
+            self.put(bank, base + offset::begin(BLOCK), &[mark])?;
+        }
+        let mut run: Option<usize> = None;
+        for i in 0..=BLOCK {
+            let changed = i < BLOCK && new.get(i) != current.data.get(i);
+            match (run, changed) {
+                (None, true) => run = Some(i),
+                (Some(start), false) => {
+                    self.put(bank, base + start, new.get(start..i).unwrap_or(&[]))?;
+                    run = None;
+                }
+                _ => {}
+            }
+        }
+        let record = Record::committed(new, seq);
+        if current.record.crc != record.crc {
+            self.put(bank, base + offset::crc(BLOCK), &record.crc.to_le_bytes())?;
+        }
+        // The commit: whichever marker does not yet say `seq` is written last.
+        if mark != seq {
+            self.put(bank, base + offset::begin(BLOCK), &[seq])
+        } else {
+            self.put(bank, base + offset::end(BLOCK), &[seq])
+        }
+    }
+
+    fn load(&mut self, bank: usize, block: usize) -> Copy<BLOCK> {
+        let mut data = [0_u8; BLOCK];
+        let mut record = [0_u8; RECORD];
+        let base = Self::slot(block);
+        let read = self.get(bank, base, &mut data).and_then(|()| self.get(bank, base + BLOCK, &mut record));
+        let record = Record::from_bytes(record);
+        if read.is_ok() {
+            self.set_block_sum(bank, block, &data);
+        }
+        let state = match read {
+            Err(_) => CopyState::Unreadable,
+            Ok(()) if record.is_valid_for(&data) => CopyState::Valid(record.seq()),
+            Ok(()) => CopyState::Invalid,
+        };
+        Copy { data, record, state }
+    }
+
+    fn set_block_sum(&mut self, bank: usize, block: usize, data: &[u8; BLOCK]) {
+        if let Some(sum) = self.block_sums.get_mut(bank).and_then(|sums| sums.get_mut(block)) {
+            // At most 255 * BLOCK; blocks beyond 257 bytes would need a wider sum.
+            *sum = data.iter().fold(0_u16, |s, &b| s.wrapping_add(u16::from(b)));
+        }
+    }
+
+    fn slot(block: usize) -> usize {
+        block * Self::SLOT
+    }
+
+    fn set_lost(&mut self, block: usize, lost: bool) {
+        if let Some(l) = self.lost.get_mut(block) {
+            *l = lost;
+        }
+    }
+
+    fn get(&mut self, bank: usize, offset: usize, buf: &mut [u8]) -> Result<(), Error> {
+        let offset = u32::try_from(offset).map_err(|_| Error::OutOfRange)?;
+        let ok = match self.banks.get_mut(bank) {
+            Some(s) => s.read(offset, buf).is_ok(),
+            None => return Err(Error::OutOfRange),
+        };
+        self.checked(bank, ok)
+    }
+
+    fn put(&mut self, bank: usize, offset: usize, bytes: &[u8]) -> Result<(), Error> {
+        let offset = u32::try_from(offset).map_err(|_| Error::OutOfRange)?;
+        let ok = match self.banks.get_mut(bank) {
+            Some(s) => s.write(offset, bytes).is_ok(),
+            None => return Err(Error::OutOfRange),
+        };
+        self.checked(bank, ok)
+    }
+
+    /// An EEPROM error sets the bank's access time-out bit.
+    fn checked(&mut self, bank: usize, ok: bool) -> Result<(), Error> {
+        if ok {
+            return Ok(());
+        }
+        if let Some(s) = self.status.get_mut(bank) {
+            s.set(BankStatus::ACCESS_TIMEOUT);
+        }
+        Err(Error::Access)
+    }
+}
