@@ -16,6 +16,7 @@
 mod dictionary;
 mod emcy;
 mod entries;
+mod hardware;
 mod modes;
 mod naming;
 mod pdos;
@@ -63,6 +64,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
     let dictionary = dictionary::dictionary(device, options);
     let serial = serial::serial_module(device, options);
     let emcy = emcy::emcy_module(device, &modes, options);
+    let hardware = hardware::hardware_module(device);
     let stack = &options.stack;
     quote! {
         /// Device name from the spec.
@@ -78,6 +80,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
         #dictionary
         #emcy
         #serial
+        #hardware
 
         /// The device's CANopen node: its dictionary, parameter store `S` and app objects `A`.
         pub type Node<A, S> = #stack::node::Node<Od<A>, S, { od::MAX_WRITE_SIZE }, { pdo::SLOTS }>;

@@ -86,11 +86,31 @@ pub struct EmcyProducer {
     last_sent_us: Option<u64>,
     /// Frames lost because the queue was full (CAN overrun of our own making).
     pub dropped: u32,
+    /// Bytes 3..7 of every frame carry the OR of the active errors' manufacturer bytes
+    /// (frenzel+berg CO40xx codes: "the bitmap of all active errors is combined with OR").
+    combine: bool,
 }
 
 impl EmcyProducer {
     pub const fn new() -> Self {
-        EmcyProducer { active: Vec::new(), queue: Deque::new(), last_sent_us: None, dropped: 0 }
+        EmcyProducer { active: Vec::new(), queue: Deque::new(), last_sent_us: None, dropped: 0, combine: false }
+    }
+
+    /// A producer whose frames carry the OR of every active error's manufacturer bytes.
+    pub const fn combining() -> Self {
+        EmcyProducer { active: Vec::new(), queue: Deque::new(), last_sent_us: None, dropped: 0, combine: true }
+    }
+
+    /// The manufacturer bytes of a frame sent now: the raised error's own (`own`), or the OR
+    /// of every active error's when combining.
+    fn manufacturer(&self, own: [u8; 5]) -> [u8; 5] {
+        if !self.combine {
+            return own;
+        }
+        self.active.iter().fold([0; 5], |mut acc, a| {
+            acc.iter_mut().zip(a.manufacturer).for_each(|(x, m)| *x |= m);
+            acc
+        })
     }
 
     /// The error register: the OR of the active errors, with the generic bit when any is.
@@ -111,7 +131,7 @@ impl EmcyProducer {
         // A full table still reports the error; it only cannot be cleared individually.
         let _ = self.active.push(Active { code: e.code, register: e.register, manufacturer: e.manufacturer, event: e.event });
         let register = self.register();
-        self.enqueue(e.code, register, e.manufacturer);
+        self.enqueue(e.code, register, self.manufacturer(e.manufacturer));
         Some(Change { register, history: Some(u32::from(e.code) | u32::from(e.manufacturer[0]) << 16 | u32::from(e.manufacturer[1]) << 24) })
     }
 
@@ -120,7 +140,7 @@ impl EmcyProducer {
         let at = self.active.iter().position(|a| a.is(e))?;
         self.active.swap_remove(at);
         let register = self.register();
-        self.enqueue(0x0000, register, [0; 5]);
+        self.enqueue(0x0000, register, self.manufacturer([0; 5]));
         Some(Change { register, history: None })
     }
 
@@ -190,6 +210,18 @@ mod tests {
         assert!(p.next(1_000, 50).is_some());
         assert_eq!(p.next(5_999, 50), None, "5 ms inhibit");
         assert!(p.next(6_000, 50).is_some());
+    }
+
+    #[test]
+    fn a_combining_producer_ors_the_codes_of_every_active_error() {
+        let bank1 = EmcyDefault { name: "bank1", code: 0x1000, register: 0x01, manufacturer: [0, 0x10, 0, 0, 0], reaction: Reaction::None, event: None, enabled_by: None };
+        let low = EmcyDefault { name: "low", manufacturer: [0, 0x40, 0, 0, 0], ..bank1 };
+        let mut p = EmcyProducer::combining();
+        p.raise(&bank1);
+        p.raise(&low);
+        p.clear(&bank1);
+        let frames: Vec<[u8; 8], 4> = core::iter::from_fn(|| p.next(0, 0)).collect();
+        assert_eq!(frames.as_slice(), [[0x00, 0x10, 0x01, 0, 0x10, 0, 0, 0], [0x00, 0x10, 0x01, 0, 0x50, 0, 0, 0], [0, 0, 0x01, 0, 0x40, 0, 0, 0]]);
     }
 
     #[test]

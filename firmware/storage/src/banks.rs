@@ -55,7 +55,7 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
     /// Bytes of one block's slot in a bank: data, then the commit record.
     pub const SLOT: usize = BLOCK + RECORD;
     /// Bytes each bank's EEPROM must provide.
-    pub const BANK_SIZE: usize = BLOCKS * Self::SLOT;
+    pub const BANK_SIZE: usize = crate::bank_size(BLOCKS, BLOCK);
     /// The user-visible data bytes.
     pub const DATA_SIZE: usize = BLOCKS * BLOCK;
     /// Per-block sums are 16-bit: a block may hold at most 257 bytes of 0xFF.

@@ -31,5 +31,10 @@ pub mod status;
 pub use banks::{Error, MirroredBanks};
 pub use status::BankStatus;
 
+/// Bytes each bank's EEPROM must provide for `blocks` blocks of `block` bytes.
+pub const fn bank_size(blocks: usize, block: usize) -> usize {
+    blocks * (block + record::RECORD)
+}
+
 #[cfg(test)]
 extern crate std;

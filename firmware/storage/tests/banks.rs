@@ -1,3 +1,4 @@
+#![allow(clippy::unwrap_used)]
 //! The mirrored banks on the CO401Memory1 geometry: basic behaviour. The exhaustive power-cut
 //! and corruption searches live in `verification/`.
 

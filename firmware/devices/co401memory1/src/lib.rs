@@ -1,13 +1,35 @@
-//! The co401memory1 device: its object dictionary tables and default PDOs, generated from
-//! `spec/co401memory1.yaml`. The device's behaviour comes with its own issue.
+//! The CO401Memory1 bus memory module (`spec/co401memory1.yaml`): 8 KiB of user data in two
+//! mirrored EEPROM banks, reached over CANopen (5000h..503Fh) and over the serial host
+//! protocol, with per-bank status and commands, bank checksums, a supply-voltage guard and a
+//! CAN monitoring channel.
+//!
+//! - [`board`]: what a board provides: configuration pins, supply reading, status outputs;
+//! - [`memory`]: the app-backed objects (memory bytes, checksums, bank status and commands)
+//!   over [`coforge_storage::MirroredBanks`];
+//! - [`supply`]: the 15 V / 11 V write guard;
+//! - [`monitor`]: the CAN monitoring channel (RPDO2's identifier);
+//! - [`host`]: the serial host protocol, on the generated codecs;
+//! - [`device`]: the whole module, driven by CAN frames, serial bytes and time.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(warnings)]
+#![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
 
 coforge_macros::device!("../../../spec/co401memory1.yaml");
 
-/// The CANopen node's settings beyond CiA 301: the frenzel+berg bus-off restart time (2180h)
-/// and boot-up message switch (2110h).
+pub mod board;
+pub mod device;
+pub mod host;
+pub mod memory;
+pub mod monitor;
+pub mod supply;
+
+pub use board::{Board, Config, ConfigError, StatusOutputs};
+pub use device::Memory1;
+pub use memory::{BLOCK, BLOCKS, BANK_SIZE, Banks, MemoryApp};
+
+/// The CANopen node's settings beyond CiA 301: the frenzel+berg bus-off restart time (2180h),
+/// boot-up message switch (2110h), and CO40xx emergency codes combined with OR.
 pub const fn node_config(node_id: u8) -> coforge_stack::node::NodeConfig {
-    coforge_stack::node::NodeConfig { restart_time_object: Some(0x2180), bootup_object: Some(0x2110), ..coforge_stack::node::NodeConfig::new(node_id) }
+    coforge_stack::node::NodeConfig { restart_time_object: Some(0x2180), bootup_object: Some(0x2110), combine_emcy_codes: true, ..coforge_stack::node::NodeConfig::new(node_id) }
 }

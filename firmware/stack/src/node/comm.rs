@@ -28,7 +28,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             (0x1014, 0) => self.check_cob_change(0x1014, 0, value),
             (0x1016, 1..) => self.check_consumer(sub, value),
             _ => match Dir::of_index(index) {
-                Some((dir, false, _)) => self.check_pdo_comm(dir, index, sub, value),
+                Some((dir, false, _)) => self.check_pdo_comm(dir, index, sub, value, side),
                 Some((dir, true, _)) => self.check_pdo_mapping(dir, index, sub, value, side),
                 None => Ok(()),
             },
@@ -48,12 +48,14 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         Ok(())
     }
 
-    fn check_pdo_comm(&mut self, dir: Dir, index: u16, sub: u8, value: u32) -> Result<(), SdoAbort> {
+    /// CiA 301 PDO communication rules. The restricted identifiers only bind the bus: device
+    /// code may put a PDO on one where its datasheet says so (CO401Memory1 monitors any ID).
+    fn check_pdo_comm(&mut self, dir: Dir, index: u16, sub: u8, value: u32, side: Side) -> Result<(), SdoAbort> {
         let valid = self.current(index, 1) & COB_INVALID == 0;
         match sub {
             1 => {
                 self.check_cob_change(index, 1, value)?;
-                if value & COB_INVALID == 0 && restricted_cob_id((value & 0x7FF) as u16) {
+                if value & COB_INVALID == 0 && side != Side::Device && restricted_cob_id((value & 0x7FF) as u16) {
                     return Err(SdoAbort::InvalidValue);
                 }
                 Ok(())

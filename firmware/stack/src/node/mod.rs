@@ -63,11 +63,13 @@ pub struct NodeConfig {
     pub restart_time_object: Option<u16>,
     /// An object whose value 0 suppresses the boot-up message (frenzel+berg 2110h).
     pub bootup_object: Option<u16>,
+    /// Emergency bytes 3..7 carry the OR of every active error's manufacturer bytes.
+    pub combine_emcy_codes: bool,
 }
 
 impl NodeConfig {
     pub const fn new(node_id: u8) -> Self {
-        NodeConfig { node_id, sdo_timeout_us: 1_000_000, startup_object: None, auto_save: false, restart_time_object: None, bootup_object: None }
+        NodeConfig { node_id, sdo_timeout_us: 1_000_000, startup_object: None, auto_save: false, restart_time_object: None, bootup_object: None, combine_emcy_codes: false }
     }
 }
 
@@ -161,7 +163,7 @@ impl<D: Dictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N,
             tx: Deque::new(),
             events: Deque::new(),
             tx_overflows: 0,
-            emcy: EmcyProducer::new(),
+            emcy: if cfg.combine_emcy_codes { EmcyProducer::combining() } else { EmcyProducer::new() },
             emcy_cob: None,
             emcy_inhibit: 0,
             sync_cob: None,

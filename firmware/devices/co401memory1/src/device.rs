@@ -1,0 +1,214 @@
+//! The whole module: the CANopen node over the memory objects, the serial host, the CAN
+//! monitoring channel and the supply guard, kept consistent after every input.
+
+use crate::board::{Board, Config, ConfigError, StatusOutputs};
+use crate::memory::MemoryApp;
+use crate::monitor::{Monitor, monitored_id};
+use crate::supply::Supply;
+use crate::{Mode, Node, Od, emcy, node_config, serial};
+use coforge_link::{Deframer, Millis};
+use coforge_stack::frame::CanFrame;
+use coforge_stack::nmt::NmtState;
+use coforge_stack::node::{BusState, NodeEvent};
+use coforge_stack::store::NoStore;
+use coforge_storage::BankStatus;
+use embedded_storage::Storage;
+use heapless::Deque;
+
+/// How often the background scrub checks one block (64 blocks: a full pass in 64 s).
+const SCRUB_PERIOD_US: u64 = 1_000_000;
+/// Frames the serial host asked to transmit that wait for the bus.
+const RAW_TX: usize = 4;
+
+/// The CO401Memory1 module on banks of type `S` and board `B`.
+#[derive(Debug)]
+pub struct Memory1<S, B> {
+    pub(crate) node: Node<MemoryApp<S>, NoStore>,
+    pub(crate) board: B,
+    config: Config,
+    host: serial::Decoder,
+    pub(crate) monitor: Monitor,
+    pub(crate) supply: Supply,
+    pub(crate) raw_tx: Deque<CanFrame, RAW_TX>,
+    pub(crate) bus_off: bool,
+    /// The bank status last reported (EMCY, TPDO1, outputs).
+    reported: [BankStatus; 2],
+    outputs: StatusOutputs,
+    next_scrub_us: u64,
+    /// Serial frames that were not a command of the protocol.
+    pub(crate) host_rejects: u32,
+}
+
+impl<S: Storage, B: Board> Memory1<S, B> {
+    /// Reads the configuration pins and mounts the banks (repairing what a power cut left).
+    pub fn new(banks: [S; 2], mut board: B) -> Result<Self, ConfigError> {
+        let config = Config::read(&mut board)?;
+        let od = Od::new(Mode::Default, config.node_id, MemoryApp::new(banks));
+        Ok(Memory1 {
+            node: Node::new(od, NoStore, node_config(config.node_id)),
+            board,
+            config,
+            host: serial::decoder(),
+            monitor: Monitor::default(),
+            supply: Supply::Normal,
+            raw_tx: Deque::new(),
+            bus_off: false,
+            reported: [BankStatus::default(); 2],
+            outputs: StatusOutputs::default(),
+            next_scrub_us: SCRUB_PERIOD_US,
+            host_rejects: 0,
+        })
+    }
+
+    /// Power-on: boot-up message, then pre-operational.
+    pub fn start(&mut self, now_us: u64) {
+        self.node.start(now_us);
+        self.update(true);
+    }
+
+    /// A frame from the bus. Frames on the monitored identifier go to the monitoring channel.
+    pub fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
+        let monitored = monitored_id(self.node.od().rpdo2_comm.cob_id_used_by_rpdo);
+        if monitored == Some(frame.id) && !frame.rtr {
+            self.monitor.capture(frame.payload());
+            let od = self.node.od_mut();
+            od.can_monitoring_byte.items = [0; 8];
+            for (dst, &b) in od.can_monitoring_byte.items.iter_mut().zip(frame.payload()) {
+                *dst = b;
+            }
+        } else {
+            self.node.on_frame(frame, now_us);
+        }
+        self.update(false);
+    }
+
+    /// Runs the timers, the supply guard and the scrub; returns the next frame to send.
+    pub fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
+        if now_us >= self.next_scrub_us {
+            self.next_scrub_us = now_us.saturating_add(SCRUB_PERIOD_US);
+            // A lost block shows in the bank status; nothing more to do here.
+            let _ = self.node.od_mut().app.banks_mut().scrub_next();
+        }
+        self.update(false);
+        if !self.bus_off
+            && let Some(frame) = self.raw_tx.pop_front()
+        {
+            return Some(frame);
+        }
+        self.node.poll(now_us)
+    }
+
+    /// One byte from the serial host at `now_ms`; writes the answer, if the byte completes a
+    /// command, into `out` and returns its length (0: nothing to send).
+    pub fn on_serial_byte(&mut self, byte: u8, now_ms: Millis, out: &mut [u8]) -> usize {
+        let mut data = [0_u8; coforge_link::nibble::MAX_DATA];
+        let (code, len) = match self.host.push(byte, now_ms) {
+            None => return 0,
+            Some(Err(_)) => {
+                self.host_rejects = self.host_rejects.wrapping_add(1);
+                return 0;
+            }
+            Some(Ok(frame)) => {
+                let n = frame.data.len().min(data.len());
+                if let (Some(dst), Some(src)) = (data.get_mut(..n), frame.data.get(..n)) {
+                    dst.copy_from_slice(src);
+                }
+                (frame.code, n)
+            }
+        };
+        let frame = coforge_link::Frame { code, length_code: None, network: None, data: data.get(..len).unwrap_or(&[]) };
+        let n = self.answer(&frame, out);
+        self.update(false);
+        n
+    }
+
+    /// The CAN controller's error state changed.
+    pub fn on_bus_state(&mut self, bus: BusState, now_us: u64) {
+        self.bus_off = bus == BusState::BusOff;
+        self.node.on_bus_state(bus, now_us);
+        self.update(false);
+    }
+
+    pub fn take_event(&mut self) -> Option<NodeEvent> {
+        self.node.take_event()
+    }
+
+    /// Serial frames dropped: cut short by a pause, or not a command of the protocol.
+    pub fn host_errors(&self) -> u32 {
+        self.host_rejects.wrapping_add(self.host.truncated)
+    }
+
+    pub fn config(&self) -> Config {
+        self.config
+    }
+
+    pub fn outputs(&self) -> StatusOutputs {
+        self.outputs
+    }
+
+    pub fn state(&self) -> NmtState {
+        self.node.state()
+    }
+
+    pub fn node(&self) -> &Node<MemoryApp<S>, NoStore> {
+        &self.node
+    }
+
+    pub fn node_mut(&mut self) -> &mut Node<MemoryApp<S>, NoStore> {
+        &mut self.node
+    }
+
+    pub fn board_mut(&mut self) -> &mut B {
+        &mut self.board
+    }
+
+    /// Brings everything derived from the banks, the supply and the monitor up to date: the
+    /// write guard, 5F00h, 2101h, 2105h, the emergencies, TPDO1 and the status outputs.
+    fn update(&mut self, force: bool) {
+        let mv = self.board.supply_mv();
+        let supply = self.supply.next(mv);
+        if supply != self.supply || force {
+            self.apply_supply(self.supply, supply);
+            self.supply = supply;
+        }
+        let od = self.node.od_mut();
+        od.supply_voltage_monitor = mv;
+        od.system_configuration = self.config.system_configuration;
+        let status = [od.app.status(0), od.app.status(1)];
+        if status != self.reported || force {
+            for (bank, (now, before)) in status.iter().zip(self.reported).enumerate() {
+                let e = if bank == 0 { &emcy::MEMORY_BANK1_ERROR } else { &emcy::MEMORY_BANK2_ERROR };
+                match (now.is_error(), before.is_error() && !force) {
+                    (true, false) => self.node.raise(e),
+                    (false, true) => self.node.clear(e),
+                    _ => {}
+                }
+            }
+            self.reported = status;
+            self.node.trigger_tpdo(1);
+        }
+        let [bank1, bank2] = status;
+        let outputs = StatusOutputs {
+            mem1_error: bank1.is_error(),
+            mem2_error: bank2.is_error(),
+            new_can_data: self.monitor.is_fresh(),
+            voltage_low: supply != Supply::Normal,
+        };
+        self.node.od_mut().api_state_register = outputs.register();
+        if outputs != self.outputs || force {
+            self.outputs = outputs;
+            self.board.set_outputs(outputs);
+        }
+    }
+
+    fn apply_supply(&mut self, before: Supply, now: Supply) {
+        self.node.od_mut().app.set_writes_allowed(now.writes_allowed());
+        for (level, e) in [(Supply::Low, &emcy::VOLTAGE_LOW), (Supply::Critical, &emcy::VOLTAGE_LOW_CRITICAL)] {
+            match (now >= level, before >= level) {
+                (true, false) => self.node.raise(e),
+                (false, true) => self.node.clear(e),
+                _ => {}
+            }
+        }
+    }
+}
