@@ -60,6 +60,11 @@ enum Cmd {
     Info { spec: PathBuf },
     /// Run a simulated device on an SLCAN bus hub over TCP (python-can:
     /// `can.Bus(interface='slcan', channel='socket://127.0.0.1:PORT', sleep_after_open=0)`).
+    ///
+    /// Lines on standard input are console commands for the first node, answered on standard
+    /// output with `coforge sim: ok ...` or `coforge sim: error ...`. CO401Memory1 takes
+    /// `supply <mV>` (the board's supply reading), `corrupt <bank 1|2> <offset> <value>` (one
+    /// EEPROM byte, offsets as in the bank layout of coforge-storage) and `outputs`.
     Sim {
         /// Device crate name: co401memory1, co401gw1, cr3101 or canopenia.
         device: String,
@@ -71,9 +76,14 @@ enum Cmd {
         /// Operating mode (default: the spec's first).
         #[arg(long)]
         mode: Option<String>,
-        /// Keep stored parameters (1010h) in this file instead of in memory.
+        /// Keep stored parameters (1010h) in this file instead of in memory (CO401Memory1:
+        /// its banks in FILE.bank1 and FILE.bank2).
         #[arg(long)]
         store: Option<PathBuf>,
+        /// Serve the first node's serial host interface on this TCP port (0 picks a free
+        /// one; the address is printed). pyserial: `serial_for_url('socket://127.0.0.1:PORT')`.
+        #[arg(long)]
+        serial: Option<u16>,
         /// Run this many nodes, with node-IDs node_id, node_id + 1, ...
         #[arg(long, default_value_t = 1)]
         nodes: u8,
@@ -124,7 +134,20 @@ fn write_output(output: Option<&Path>, text: &str) -> Result<(), String> {
     }
 }
 
-fn sim(device: &str, first_id: u8, port: u16, mode: Option<&str>, store: Option<PathBuf>, count: u8, seconds: Option<u64>) -> Result<ExitCode, String> {
+/// How `coforge sim` was asked to run.
+struct SimArgs<'a> {
+    device: &'a str,
+    first_id: u8,
+    port: u16,
+    mode: Option<&'a str>,
+    store: Option<PathBuf>,
+    count: u8,
+    seconds: Option<u64>,
+    serial: Option<u16>,
+}
+
+fn sim(args: SimArgs<'_>) -> Result<ExitCode, String> {
+    let SimArgs { device, first_id, port, mode, store, count, seconds, serial } = args;
     use coforge_sim::devices::{DeviceKind, StoreAt};
     let kind = DeviceKind::find(device)?;
     if count == 0 || u16::from(first_id) + u16::from(count) - 1 > 127 {
@@ -136,7 +159,15 @@ fn sim(device: &str, first_id: u8, port: u16, mode: Option<&str>, store: Option<
     let at = store.map_or(StoreAt::Memory, StoreAt::File);
     let nodes = (first_id..first_id + count).map(|id| kind.create(mode, id, &at)).collect::<Result<Vec<_>, _>>()?;
     let hub = coforge_sim::hub::Hub::bind(("127.0.0.1", port)).map_err(|e| format!("cannot listen on port {port}: {e}"))?;
+    let has_serial = nodes.first().is_some_and(|n| n.has_serial());
     let running = coforge_sim::runner::spawn(&hub, nodes);
+    if let Some(serial_port) = serial {
+        if !has_serial {
+            return Err(format!("{} has no serial host interface", kind.name));
+        }
+        let port = coforge_sim::serial::serve(("127.0.0.1", serial_port), 0, running.inputs()).map_err(|e| format!("cannot listen on port {serial_port}: {e}"))?;
+        println!("coforge sim: serial host on socket://{}", port.local_addr());
+    }
     // Tests and scripts wait for this line before connecting.
     println!(
         "coforge sim: {} node-ID {first_id}{} on slcan socket://{}",
@@ -146,12 +177,8 @@ fn sim(device: &str, first_id: u8, port: u16, mode: Option<&str>, store: Option<
     );
     use std::io::Write as _;
     let _ = std::io::stdout().flush();
-    match seconds {
-        Some(s) => std::thread::sleep(std::time::Duration::from_secs(s)),
-        None => loop {
-            std::thread::park();
-        },
-    }
+    let deadline = seconds.map(|s| std::time::Instant::now() + std::time::Duration::from_secs(s));
+    console(&running, deadline);
     let stats = &running.stats;
     use std::sync::atomic::Ordering::Relaxed;
     println!(
@@ -165,9 +192,48 @@ fn sim(device: &str, first_id: u8, port: u16, mode: Option<&str>, store: Option<
     Ok(ExitCode::SUCCESS)
 }
 
+/// Runs console commands from standard input until the deadline (or forever).
+fn console(running: &coforge_sim::runner::Running, deadline: Option<std::time::Instant>) {
+    use std::io::{BufRead as _, Write as _};
+    let (lines_tx, lines) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in std::io::stdin().lock().lines().map_while(Result::ok) {
+            if lines_tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    loop {
+        let wait = deadline.map_or(std::time::Duration::from_secs(3600), |d| d.saturating_duration_since(std::time::Instant::now()));
+        if wait.is_zero() {
+            return;
+        }
+        match lines.recv_timeout(wait) {
+            Ok(line) if line.trim().is_empty() => {}
+            Ok(line) => {
+                match running.control(0, line.trim()) {
+                    Ok(what) => println!("coforge sim: ok {what}"),
+                    Err(why) => println!("coforge sim: error {why}"),
+                }
+                let _ = std::io::stdout().flush();
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            // Standard input closed: keep running until the deadline or a signal.
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => match deadline {
+                Some(d) => std::thread::sleep(d.saturating_duration_since(std::time::Instant::now())),
+                None => loop {
+                    std::thread::park();
+                },
+            },
+        }
+    }
+}
+
 fn run(cmd: Cmd) -> Result<ExitCode, String> {
     match cmd {
-        Cmd::Sim { device, node_id, port, mode, store, nodes, seconds } => sim(&device, node_id, port, mode.as_deref(), store, nodes, seconds),
+        Cmd::Sim { device, node_id, port, mode, store, nodes, seconds, serial } => {
+            sim(SimArgs { device: &device, first_id: node_id, port, mode: mode.as_deref(), store, count: nodes, seconds, serial })
+        }
         Cmd::Check { specs } => {
             let mut failed = 0;
             for path in &specs {

@@ -27,6 +27,19 @@ pub trait SimNode: Send {
     fn trigger_tpdo(&mut self, number: u16);
     /// CiA 303-3 indicator states.
     fn leds(&self) -> coforge_stack::leds::Leds;
+    /// Whether the device has a serial host interface.
+    fn has_serial(&self) -> bool {
+        false
+    }
+    /// One byte from the serial host, received at `now_ms`; the answer, if this byte
+    /// completes a command, goes to `out` and its length is returned.
+    fn serial_byte(&mut self, _byte: u8, _now_ms: u32, _out: &mut [u8]) -> usize {
+        0
+    }
+    /// A fault-injection command from the simulator's console (see `coforge sim --help`).
+    fn control(&mut self, command: &str) -> Result<String, String> {
+        Err(format!("this device takes no console commands (got `{command}`)"))
+    }
 }
 
 impl<D, S, const N: usize, const P: usize> SimNode for Node<D, S, N, P>
@@ -87,22 +100,34 @@ pub enum StoreAt {
     File(PathBuf),
 }
 
-/// Builds a node of one device: mode name, node-ID, parameter storage.
-type Build = fn(Option<&str>, u8, MemStorage) -> Result<Box<dyn SimNode>, String>;
+/// Builds a node of one device: mode name, node-ID, where its non-volatile memory lives.
+type Build = fn(Option<&str>, u8, &StoreAt) -> Result<Box<dyn SimNode>, String>;
 
 /// A device the simulator can run.
 #[derive(Debug, Clone, Copy)]
 pub struct DeviceKind {
     pub name: &'static str,
     build: Build,
-    persistent_size: usize,
+}
+
+/// An EEPROM of `capacity` bytes at `store`; `suffix` tells several apart in one file name.
+pub fn eeprom(store: &StoreAt, capacity: usize, suffix: &str) -> Result<MemStorage, String> {
+    match store {
+        StoreAt::Memory => Ok(MemStorage::new(capacity)),
+        StoreAt::File(path) => {
+            let mut name = path.clone().into_os_string();
+            name.push(suffix);
+            let path = PathBuf::from(name);
+            MemStorage::with_file(capacity, &path).map_err(|e| format!("{}: {e}", path.display()))
+        }
+    }
 }
 
 macro_rules! device_kind {
     ($krate:ident) => {
         DeviceKind {
             name: stringify!($krate),
-            build: |mode, node_id, storage| {
+            build: |mode, node_id, store| {
                 let mode = match mode {
                     None => $krate::Mode::ALL[0],
                     Some(name) => $krate::Mode::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
@@ -110,17 +135,18 @@ macro_rules! device_kind {
                         format!("{} has no mode `{name}`; its modes are: {}", stringify!($krate), known.join(", "))
                     })?,
                 };
+                let size = <$krate::Od<RamApp> as Dictionary>::PERSISTENT_SIZE;
+                let storage = eeprom(store, BlockStore::<MemStorage>::capacity_for(size), "")?;
                 let od = $krate::Od::new(mode, node_id, RamApp::default());
                 let node: $krate::Node<RamApp, BlockStore<MemStorage>> = Node::new(od, BlockStore::new(storage, 0), $krate::node_config(node_id));
                 Ok(Box::new(node))
             },
-            persistent_size: <$krate::Od<RamApp> as Dictionary>::PERSISTENT_SIZE,
         }
     };
 }
 
 /// Every device, by crate name.
-pub const DEVICES: [DeviceKind; 4] = [device_kind!(co401memory1), device_kind!(co401gw1), device_kind!(cr3101), device_kind!(canopenia)];
+pub const DEVICES: [DeviceKind; 4] = [DeviceKind { name: "co401memory1", build: crate::memory1::build }, device_kind!(co401gw1), device_kind!(cr3101), device_kind!(canopenia)];
 
 impl DeviceKind {
     pub fn find(name: &str) -> Result<DeviceKind, String> {
@@ -135,11 +161,6 @@ impl DeviceKind {
         if !(1..=127).contains(&node_id) {
             return Err(format!("node-ID {node_id} is outside 1..=127"));
         }
-        let capacity = BlockStore::<MemStorage>::capacity_for(self.persistent_size);
-        let storage = match store {
-            StoreAt::Memory => MemStorage::new(capacity),
-            StoreAt::File(path) => MemStorage::with_file(capacity, path).map_err(|e| format!("{}: {e}", path.display()))?,
-        };
-        (self.build)(mode, node_id, storage)
+        (self.build)(mode, node_id, store)
     }
 }

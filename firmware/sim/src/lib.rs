@@ -4,7 +4,9 @@
 //! - [`slcan`]: the Lawicel ASCII protocol, an encoder and a streaming decoder that never panics;
 //! - [`hub`]: the bus, a TCP SLCAN listener plus in-process [`hub::Port`]s;
 //! - [`devices`]: the four coforge devices as [`devices::SimNode`]s, by name;
+//! - [`memory1`]: CO401Memory1's own board (pins, supply) and console commands;
 //! - [`runner`]: real-time nodes on a hub, one thread for all of them;
+//! - [`serial`]: a device's serial host interface on a TCP port;
 //! - [`vbus`]: a deterministic in-process bus on a virtual clock, for tests;
 //! - [`storage`], [`app`]: parameter storage (memory or file) and app-backed objects.
 #![forbid(unsafe_code)]
@@ -14,7 +16,9 @@
 pub mod app;
 pub mod devices;
 pub mod hub;
+pub mod memory1;
 pub mod runner;
+pub mod serial;
 pub mod slcan;
 pub mod storage;
 pub mod vbus;

@@ -5,6 +5,7 @@ use crate::devices::SimNode;
 use crate::hub::{Hub, Port};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, Sender, channel};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -21,15 +22,37 @@ pub struct Stats {
     pub steps: AtomicU64,
 }
 
+/// Input for a running node other than CAN frames: its serial host, and the console.
+#[derive(Debug)]
+pub enum Input {
+    /// A byte from the node's serial host, received at `at`; answers go to `reply`.
+    Serial { node: usize, byte: u8, at: Instant, reply: Sender<Vec<u8>> },
+    /// A console command (fault injection); the outcome goes to `reply`.
+    Control { node: usize, command: String, reply: Sender<Result<String, String>> },
+}
+
 /// Nodes running on a background thread until [`Running::stop`] or drop.
 #[derive(Debug)]
 pub struct Running {
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<()>>,
     pub stats: Arc<Stats>,
+    inputs: Sender<Input>,
 }
 
 impl Running {
+    /// Where serial bytes and console commands for the nodes go.
+    pub fn inputs(&self) -> Sender<Input> {
+        self.inputs.clone()
+    }
+
+    /// Runs a console command on node `node` and waits for its outcome.
+    pub fn control(&self, node: usize, command: &str) -> Result<String, String> {
+        let (reply, outcome) = channel();
+        self.inputs.send(Input::Control { node, command: command.to_string(), reply }).map_err(|_| "the simulation has stopped".to_string())?;
+        outcome.recv().map_err(|_| "the simulation has stopped".to_string())?
+    }
+
     pub fn stop(mut self) {
         self.halt();
     }
@@ -56,18 +79,21 @@ pub fn spawn(hub: &Hub, nodes: Vec<Box<dyn SimNode>>) -> Running {
     let stop = Arc::new(AtomicBool::new(false));
     let stats = Arc::new(Stats::default());
     let (stop2, stats2) = (stop.clone(), stats.clone());
-    let (booted_tx, booted) = std::sync::mpsc::channel();
-    let thread = std::thread::Builder::new().name("coforge-sim".into()).spawn(move || run(nodes, ports, &stop2, &stats2, &booted_tx)).ok();
+    let (booted_tx, booted) = channel();
+    let (inputs, inputs_rx) = channel();
+    let thread = std::thread::Builder::new().name("coforge-sim".into()).spawn(move || run(nodes, ports, &stop2, &stats2, &booted_tx, &inputs_rx)).ok();
     // If the thread could not start, there is nothing to wait for.
     if thread.is_some() {
         let _ = booted.recv();
     }
-    Running { stop, thread, stats }
+    Running { stop, thread, stats, inputs }
 }
 
-fn run(mut nodes: Vec<Box<dyn SimNode>>, ports: Vec<Port>, stop: &AtomicBool, stats: &Stats, booted: &std::sync::mpsc::Sender<()>) {
+fn run(mut nodes: Vec<Box<dyn SimNode>>, ports: Vec<Port>, stop: &AtomicBool, stats: &Stats, booted: &Sender<()>, inputs: &Receiver<Input>) {
     let epoch = Instant::now();
     let now_us = || u64::try_from(epoch.elapsed().as_micros()).unwrap_or(u64::MAX);
+    // Serial bytes carry their arrival time, so a pause between them is seen as the host made it.
+    let ms_at = |at: Instant| u32::try_from(at.saturating_duration_since(epoch).as_millis() % (1 << 32)).unwrap_or(0);
     for (node, port) in nodes.iter_mut().zip(&ports) {
         node.start(now_us());
         while let Some(frame) = node.poll(now_us()) {
@@ -78,6 +104,22 @@ fn run(mut nodes: Vec<Box<dyn SimNode>>, ports: Vec<Port>, stop: &AtomicBool, st
     while !stop.load(Ordering::Relaxed) {
         let started = Instant::now();
         let mut busy = false;
+        while let Ok(input) = inputs.try_recv() {
+            busy = true;
+            match input {
+                Input::Serial { node, byte, at, reply } => {
+                    let mut out = [0_u8; 32];
+                    let n = nodes.get_mut(node).map_or(0, |n| n.serial_byte(byte, ms_at(at), &mut out));
+                    if n > 0 {
+                        let _ = reply.send(out.get(..n).unwrap_or(&[]).to_vec());
+                    }
+                }
+                Input::Control { node, command, reply } => {
+                    let outcome = nodes.get_mut(node).map_or_else(|| Err(format!("no node {node}")), |n| n.control(&command));
+                    let _ = reply.send(outcome);
+                }
+            }
+        }
         for (node, port) in nodes.iter_mut().zip(&ports) {
             while let Some(frame) = port.try_recv() {
                 node.on_frame(&frame, now_us());
