@@ -2,13 +2,16 @@
 //! keeping generation in an ordinary library makes it testable and printable
 //! (`coforge dump`).
 //!
-//! Generated so far (issue 3 adds the typed dictionary, its dispatch and the serial codecs):
+//! Generated per device:
 //! - `Mode`: the device's operating modes (`Mode::Default` for a device without modes);
 //! - `od::entries(mode)`: the sorted [`EntryInfo`] table, identical sub-entries merged into
 //!   runs, value limits in shared statics;
 //! - `pdo::rpdos(mode)` / `pdo::tpdos(mode)`: the default PDOs, with compile-time checks that
 //!   every mapping fits a CAN frame;
-//! - identity constants.
+//! - `Od<A>`: the typed dictionary and its `ObjectDictionary`/`Dictionary` dispatch;
+//! - `emcy::*`: the spec's emergencies; `serial::*`: the host protocol's codecs;
+//! - `hardware::*`: decoders of the configuration pins (node-ID, bit rates, configuration);
+//! - identity constants and the `Node<A, S>` alias.
 //!
 //! [`EntryInfo`]: https://docs.rs/coforge-stack
 #![forbid(unsafe_code)]
