@@ -163,52 +163,44 @@ impl<S: Storage, B: Board> Memory1<S, B> {
     }
 
     /// Brings everything derived from the banks, the supply and the monitor up to date: the
-    /// write guard, 5F00h, 2101h, 2105h, the emergencies, TPDO1 and the status outputs.
+    /// write guard, 5F00h, 2101h, 2105h, the emergencies, TPDO1 and the status outputs. The
+    /// emergencies follow the conditions, so an NMT reset that forgets them raises them again.
     fn update(&mut self, force: bool) {
         let mv = self.board.supply_mv();
-        let supply = self.supply.next(mv);
-        if supply != self.supply || force {
-            self.apply_supply(self.supply, supply);
-            self.supply = supply;
-        }
+        self.supply = self.supply.next(mv);
         let od = self.node.od_mut();
+        od.app.set_writes_allowed(self.supply.writes_allowed());
         od.supply_voltage_monitor = mv;
         od.system_configuration = self.config.system_configuration;
         let status = [od.app.status(0), od.app.status(1)];
-        if status != self.reported || force {
-            for (bank, (now, before)) in status.iter().zip(self.reported).enumerate() {
-                let e = if bank == 0 { &emcy::MEMORY_BANK1_ERROR } else { &emcy::MEMORY_BANK2_ERROR };
-                match (now.is_error(), before.is_error() && !force) {
-                    (true, false) => self.node.raise(e),
-                    (false, true) => self.node.clear(e),
-                    _ => {}
-                }
+        let [bank1, bank2] = status;
+        let conditions = [
+            (&emcy::MEMORY_BANK1_ERROR, bank1.is_error()),
+            (&emcy::MEMORY_BANK2_ERROR, bank2.is_error()),
+            (&emcy::VOLTAGE_LOW, self.supply >= Supply::Low),
+            (&emcy::VOLTAGE_LOW_CRITICAL, self.supply >= Supply::Critical),
+        ];
+        for (e, active) in conditions {
+            match (active, self.node.is_active(e)) {
+                (true, false) => self.node.raise(e),
+                (false, true) => self.node.clear(e),
+                _ => {}
             }
+        }
+        if status != self.reported || force {
             self.reported = status;
             self.node.trigger_tpdo(1);
         }
-        let [bank1, bank2] = status;
         let outputs = StatusOutputs {
             mem1_error: bank1.is_error(),
             mem2_error: bank2.is_error(),
             new_can_data: self.monitor.is_fresh(),
-            voltage_low: supply != Supply::Normal,
+            voltage_low: self.supply != Supply::Normal,
         };
         self.node.od_mut().api_state_register = outputs.register();
         if outputs != self.outputs || force {
             self.outputs = outputs;
             self.board.set_outputs(outputs);
-        }
-    }
-
-    fn apply_supply(&mut self, before: Supply, now: Supply) {
-        self.node.od_mut().app.set_writes_allowed(now.writes_allowed());
-        for (level, e) in [(Supply::Low, &emcy::VOLTAGE_LOW), (Supply::Critical, &emcy::VOLTAGE_LOW_CRITICAL)] {
-            match (now >= level, before >= level) {
-                (true, false) => self.node.raise(e),
-                (false, true) => self.node.clear(e),
-                _ => {}
-            }
         }
     }
 }

@@ -61,6 +61,7 @@ impl Rig {
         dev.start(0);
         let mut rig = Rig { dev, now_us: 0, sent: Vec::new() };
         rig.run(1_000);
+        assert_eq!(rig.sent.first().map(|f| (f.id, f.payload().to_vec())), Some((0x700 + NODE, vec![0])), "boot-up first");
         rig
     }
 
@@ -305,4 +306,18 @@ fn a_power_cut_image_is_recovered_at_start_up() {
     assert_eq!(rig.upload(0x6000, 1), Ok(0x30));
     assert_eq!(rig.upload(0x6000, 2), Ok(0));
     assert_eq!(rig.dev.node().od().app.banks().banks()[0].as_bytes()[..132], banks[0].as_bytes()[..132]);
+}
+
+#[test]
+fn an_nmt_reset_forgets_the_emergencies_but_the_conditions_raise_them_again() {
+    let mut rig = Rig::new();
+    rig.take_sent();
+    rig.frame(0x000, &[0x81, NODE as u8]);
+    rig.run(2_000);
+    let sent = rig.take_sent();
+    assert!(sent.iter().any(|f| f.id == 0x700 + NODE && f.payload() == [0]), "boot-up after the reset");
+    let emcy: Vec<_> = sent.iter().filter(|f| f.id == 0x80 + NODE).map(|f| f.data).collect();
+    // Both banks still report "cleared": bank 1's code, then both ORed.
+    assert_eq!(emcy, [hex("00 10 01 00 10 00 00 00").try_into().unwrap(), hex("00 10 01 00 30 00 00 00").try_into().unwrap()] as [[u8; 8]; 2]);
+    assert_eq!(rig.upload(0x1001, 0), Ok(0x01));
 }

@@ -292,6 +292,11 @@ impl<D: Dictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N,
         self.core.clear(e);
     }
 
+    /// Whether an emergency is active (raised and not cleared, nor forgotten by a reset).
+    pub fn is_active(&self, e: &EmcyDefault) -> bool {
+        self.core.emcy.is_active(e)
+    }
+
     /// The current error register (1001h).
     pub fn error_register(&self) -> u8 {
         self.core.emcy.register()
