@@ -321,3 +321,24 @@ fn an_nmt_reset_forgets_the_emergencies_but_the_conditions_raise_them_again() {
     assert_eq!(emcy, [hex("00 10 01 00 10 00 00 00").try_into().unwrap(), hex("00 10 01 00 30 00 00 00").try_into().unwrap()] as [[u8; 8]; 2]);
     assert_eq!(rig.upload(0x1001, 0), Ok(0x01));
 }
+
+#[test]
+fn bus_off_goes_out_on_recovery_with_the_active_warning_ored_in() {
+    use coforge_stack::node::BusState;
+    let mut rig = Rig::new();
+    rig.serial(&hex("12 01 91"));
+    rig.serial(&hex("12 02 91"));
+    rig.take_sent();
+    rig.dev.on_bus_state(BusState::Warning, rig.now_us);
+    rig.run(1_000);
+    assert_eq!(rig.emergencies(), [hex("00 81 11 00 00 00 00 40").try_into().unwrap()] as [[u8; 8]; 1]);
+    rig.dev.on_bus_state(BusState::BusOff, rig.now_us);
+    rig.run(1_000);
+    assert!(rig.take_sent().is_empty(), "nothing leaves a bus-off controller");
+    rig.dev.on_bus_state(BusState::Active, rig.now_us);
+    rig.run(2_000);
+    let emcy = rig.emergencies();
+    // Erratum MEM-20: the bus-off frame with the warning's code ORed in (0xC0000000).
+    assert_eq!(emcy.first(), Some(&hex("40 81 11 00 00 00 00 C0").try_into().unwrap()), "{emcy:02x?}");
+    assert_eq!(emcy.last().map(|f| (f[0], f[1], f[2])), Some((0, 0, 0)), "all cleared at the end: {emcy:02x?}");
+}
