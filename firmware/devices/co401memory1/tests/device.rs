@@ -342,3 +342,20 @@ fn bus_off_goes_out_on_recovery_with_the_active_warning_ored_in() {
     assert_eq!(emcy.first(), Some(&hex("40 81 11 00 00 00 00 C0").try_into().unwrap()), "{emcy:02x?}");
     assert_eq!(emcy.last().map(|f| (f[0], f[1], f[2])), Some((0, 0, 0)), "all cleared at the end: {emcy:02x?}");
 }
+
+#[test]
+fn a_block_lost_in_both_banks_is_refused_on_both_sides_never_returned() {
+    let mut rig = Rig::new();
+    rig.download(0x5003, 1, &[0x33]).unwrap();
+    let addr = 3 * (128 + 4);
+    for bank in rig.dev.node_mut().od_mut().app.banks_mut().banks_mut() {
+        bank.as_bytes_mut()[addr] ^= 0x01;
+    }
+    let mut lost = Rig::with_banks(rig.dev.node().od().app.banks().banks().clone());
+    assert_eq!(lost.upload(0x5003, 1), Err(0x0606_0000), "hardware error, not garbage");
+    assert_eq!(lost.serial(&hex("33 03 50 02")), hex("32 00 00"));
+    assert_eq!(lost.upload(0x6000, 1).map(|s| s & 0x10), Ok(0x10));
+    assert_eq!(lost.upload(0x6000, 2).map(|s| s & 0x10), Ok(0x10));
+    // Other blocks are unaffected.
+    assert_eq!(lost.upload(0x5004, 1), Ok(0));
+}
