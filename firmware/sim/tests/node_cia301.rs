@@ -229,9 +229,21 @@ fn sync_cycle_monitoring_from_1006() {
     assert_eq!(emcy_frames(&mut bus), vec![[0, 0, 0, 0, 0, 0, 0, 0]], "the next SYNC resets the error");
 }
 
+/// CO401GW1 with CiA 301 4.2 RPDO deadline monitoring switched on (the chip itself has it off,
+/// erratum GW1-13), to check the stack's monitor.
+fn gw1_with_rpdo_deadlines() -> Box<dyn SimNode> {
+    use coforge_sim::app::RamApp;
+    use coforge_stack::store::NoStore;
+    let config = coforge_stack::node::NodeConfig { rpdo_deadlines: true, ..co401gw1::node_config(ID) };
+    let od = co401gw1::Od::new(co401gw1::Mode::ALL[0], ID, RamApp::default());
+    let node: co401gw1::Node<RamApp, NoStore> = coforge_stack::node::Node::new(od, NoStore, config);
+    Box::new(node)
+}
+
 #[test]
 fn rpdo_deadline_monitoring_from_its_event_timer() {
-    let mut bus = bus("co401gw1");
+    let mut bus = VirtualBus::new(vec![gw1_with_rpdo_deadlines()]);
+    bus.drain();
     download(&mut bus, 0x1400, 5, &50_u16.to_le_bytes()).unwrap();
     nmt(&mut bus, 0x01);
     bus.drain();
@@ -244,6 +256,21 @@ fn rpdo_deadline_monitoring_from_its_event_timer() {
     assert_eq!(emcy_frames(&mut bus), vec![[0x50, 0x82, 0x11, 0, 0, 0, 0, 0]], "RPDO timeout 8250h");
     bus.send(frame(0x205, &[0; 8]));
     assert_eq!(emcy_frames(&mut bus), vec![[0, 0, 0, 0, 0, 0, 0, 0]], "the next RPDO resets the error");
+}
+
+#[test]
+fn ds301_4_0_devices_do_not_monitor_rpdo_deadlines() {
+    for device in ["co401gw1", "co401memory1"] {
+        let mut bus = VirtualBus::new(vec![node(device)]);
+        bus.drain();
+        download(&mut bus, 0x1400, 5, &50_u16.to_le_bytes()).unwrap();
+        nmt(&mut bus, 0x01);
+        bus.send(frame(0x205, &[0x91, 0x91, 0, 0, 0, 0, 0, 0][..if device == "co401gw1" { 8 } else { 2 }]));
+        bus.drain();
+        bus.advance_ms(500);
+        let late = emcy_frames(&mut bus);
+        assert!(!late.iter().any(|f| f[..2] == [0x50, 0x82]), "{device}: no 8250h (errata GW1-13, MEM-27): {late:02x?}");
+    }
 }
 
 #[test]

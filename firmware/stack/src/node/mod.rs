@@ -65,11 +65,14 @@ pub struct NodeConfig {
     pub bootup_object: Option<u16>,
     /// Emergency bytes 3..7 carry the OR of every active error's manufacturer bytes.
     pub combine_emcy_codes: bool,
+    /// An RPDO's event timer (14xxh.5) is a deadline monitor (CiA 301 4.2, EMCY 8250h). Off
+    /// for DS301 4.0 devices, where the entry exists but has no function for RPDOs.
+    pub rpdo_deadlines: bool,
 }
 
 impl NodeConfig {
     pub const fn new(node_id: u8) -> Self {
-        NodeConfig { node_id, sdo_timeout_us: 1_000_000, startup_object: None, auto_save: false, restart_time_object: None, bootup_object: None, combine_emcy_codes: false }
+        NodeConfig { node_id, sdo_timeout_us: 1_000_000, startup_object: None, auto_save: false, restart_time_object: None, bootup_object: None, combine_emcy_codes: false, rpdo_deadlines: true }
     }
 }
 

@@ -39,7 +39,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             self.sync_lost = true;
             self.raise_event(EmcyEvent::SyncTimeout);
         }
-        if nmt::allows_pdo(self.state) {
+        if self.cfg.rpdo_deadlines && nmt::allows_pdo(self.state) {
             // Every RPDO records its own timeout; one emergency covers them all.
             let mut overdue = false;
             for r in &mut self.rpdos {
