@@ -43,3 +43,103 @@ proptest! {
         prop_resync_after_garbage(&garbage, code, &data);
     }
 }
+
+/// The mirrored banks on the geometry of the Kani harnesses (2 blocks of 8 bytes, 24 bytes per
+/// bank), with structured contents: committed banks, erased or random ones, then a few bytes
+/// of either bank overwritten.
+mod banks_small {
+    use coforge_verification::banks::*;
+    use proptest::prelude::*;
+
+    pub type Devices<'p> = [CutEeprom<'p, 24>; 2];
+
+    /// `kind` 0..=3: committed, bank 2 erased, both erased, random; then `mutations`.
+    pub fn devices<'p>(
+        power: &'p Power,
+        kind: u8,
+        data: &[[u8; 8]; 2],
+        seqs: &[u8; 2],
+        random: &[[u8; 24]; 2],
+        mutations: &[(usize, usize, u8)],
+    ) -> Devices<'p> {
+        let mut d = committed_devices::<24, 2, 8>(power, data, seqs);
+        match kind % 4 {
+            1 => d[1] = CutEeprom::erased(power),
+            2 => d = [CutEeprom::erased(power), CutEeprom::erased(power)],
+            3 => d = [CutEeprom::new(power, random[0]), CutEeprom::new(power, random[1])],
+            _ => {}
+        }
+        for &(bank, pos, value) in mutations {
+            d[bank % 2].as_bytes_mut()[pos % 24] = value;
+        }
+        d
+    }
+
+    pub fn mutations() -> impl Strategy<Value = Vec<(usize, usize, u8)>> {
+        proptest::collection::vec((0..2_usize, 0..24_usize, any::<u8>()), 0..5)
+    }
+
+    pub fn cut() -> impl Strategy<Value = CutByte> {
+        (any::<u8>(), any::<u8>()).prop_map(|(s, g)| CutByte::select(s, g))
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 10_000, ..ProptestConfig::default() })]
+
+    #[test]
+    fn banks_write_cut_leaves_old_or_new(data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), addr in 0..=17_usize, bytes in proptest::collection::vec(any::<u8>(), 0..=16), cut_at in 0..50_u32, cut in banks_small::cut()) {
+        use coforge_verification::banks::*;
+        let power = Power::new();
+        prop_write_cut::<24, 2, 8>(committed_devices::<24, 2, 8>(&power, &data, &seqs), addr, &bytes, cut_at, cut);
+    }
+
+    #[test]
+    fn banks_recovery_is_idempotent(kind in any::<u8>(), data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), random in any::<[[u8; 24]; 2]>(), mutations in banks_small::mutations()) {
+        use coforge_verification::banks::*;
+        let power = Power::new();
+        prop_recovery_idempotent::<24, 2, 8>(banks_small::devices(&power, kind, &data, &seqs, &random, &mutations));
+    }
+
+    #[test]
+    fn banks_recovery_cut_at_any_byte(kind in any::<u8>(), data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), random in any::<[[u8; 24]; 2]>(), mutations in banks_small::mutations(), cut_at in 0..60_u32, cut in banks_small::cut()) {
+        use coforge_verification::banks::*;
+        let power = Power::new();
+        prop_recovery_cut::<24, 2, 8>(banks_small::devices(&power, kind, &data, &seqs, &random, &mutations), cut_at, cut);
+    }
+
+    #[test]
+    fn banks_single_corruption_is_found_and_repaired(data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), bank in 0..2_usize, pos in 0..24_usize, value in any::<u8>(), via in any::<u8>()) {
+        use coforge_verification::banks::*;
+        let power = Power::new();
+        let banks = Banks::<24, 2, 8>::mount(committed_devices::<24, 2, 8>(&power, &data, &seqs));
+        prop_assume!(banks.banks()[bank].as_bytes()[pos] != value);
+        prop_single_corruption(banks, bank, pos, value, Detect::select(via));
+    }
+
+    #[test]
+    fn banks_double_corruption_is_lost(data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), block in 0..2_usize, offsets in any::<[usize; 2]>(), flips in any::<[u8; 2]>(), via in any::<u8>()) {
+        use coforge_verification::banks::*;
+        prop_assume!(data[block] != [0; 8] || seqs[block] != 0);
+        prop_assume!(flips != [0, 0] && flips[0] != 0 && flips[1] != 0);
+        let power = Power::new();
+        let banks = Banks::<24, 2, 8>::mount(committed_devices::<24, 2, 8>(&power, &data, &seqs));
+        let offsets = offsets.map(|o| o % 12);
+        let values = [0, 1].map(|b| banks.banks()[b].as_bytes()[block * 12 + offsets[b]] ^ flips[b]);
+        prop_double_corruption(banks, block, offsets, values, Detect::select(via));
+    }
+
+    #[test]
+    fn banks_checksum_matches_after_operations(kind in any::<u8>(), data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), random in any::<[[u8; 24]; 2]>(), mutations in banks_small::mutations(), ops in proptest::collection::vec(any::<[u8; 6]>(), 0..16)) {
+        use coforge_verification::banks::*;
+        let power = Power::new();
+        prop_checksum_after_ops::<24, 2, 8>(banks_small::devices(&power, kind, &data, &seqs, &random, &mutations), &ops);
+    }
+
+    #[test]
+    fn banks_are_total(kind in any::<u8>(), data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), random in any::<[[u8; 24]; 2]>(), mutations in banks_small::mutations(), unreadable in any::<[bool; 2]>(), ops in proptest::collection::vec(any::<[u8; 6]>(), 0..16)) {
+        use coforge_verification::banks::*;
+        let power = Power::new();
+        prop_banks_total::<24, 2, 8>(banks_small::devices(&power, kind, &data, &seqs, &random, &mutations), unreadable, &ops);
+    }
+}

@@ -165,7 +165,8 @@ fn sim(args: SimArgs<'_>) -> Result<ExitCode, String> {
         if !has_serial {
             return Err(format!("{} has no serial host interface", kind.name));
         }
-        let port = coforge_sim::serial::serve(("127.0.0.1", serial_port), 0, running.inputs()).map_err(|e| format!("cannot listen on port {serial_port}: {e}"))?;
+        let port =
+            coforge_sim::serial::serve(("127.0.0.1", serial_port), 0, running.inputs()).map_err(|e| format!("cannot listen on port {serial_port}: {e}"))?;
         println!("coforge sim: serial host on socket://{}", port.local_addr());
     }
     // Tests and scripts wait for this line before connecting.

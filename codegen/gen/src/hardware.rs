@@ -41,7 +41,8 @@ fn selector_fn(name: &str, s: &Selector) -> Option<TokenStream> {
         let (low, high) = (crate::dec(u64::try_from(low).unwrap_or(0)), crate::dec(u64::try_from(high).unwrap_or(0)));
         quote!(match code { #(#reserved)|* => None, c if c >= #low && c <= #high => Some(c as u32), _ => None })
     };
-    let value = if s.codes.iter().any(|c| c.reserved) || s.codes.iter().any(|c| c.value.is_some()) || s.range.is_some() { value } else { quote!(Some(code as u32)) };
+    let value =
+        if s.codes.iter().any(|c| c.reserved) || s.codes.iter().any(|c| c.value.is_some()) || s.range.is_some() { value } else { quote!(Some(code as u32)) };
     Some(quote! {
         #[doc = #doc]
         #[allow(clippy::match_single_binding, clippy::manual_range_contains, clippy::absurd_extreme_comparisons, unused_comparisons, unreachable_patterns)]

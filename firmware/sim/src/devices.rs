@@ -146,7 +146,8 @@ macro_rules! device_kind {
 }
 
 /// Every device, by crate name.
-pub const DEVICES: [DeviceKind; 4] = [DeviceKind { name: "co401memory1", build: crate::memory1::build }, device_kind!(co401gw1), device_kind!(cr3101), device_kind!(canopenia)];
+pub const DEVICES: [DeviceKind; 4] =
+    [DeviceKind { name: "co401memory1", build: crate::memory1::build }, device_kind!(co401gw1), device_kind!(cr3101), device_kind!(canopenia)];
 
 impl DeviceKind {
     pub fn find(name: &str) -> Result<DeviceKind, String> {

@@ -214,7 +214,15 @@ mod tests {
 
     #[test]
     fn a_combining_producer_ors_the_codes_of_every_active_error() {
-        let bank1 = EmcyDefault { name: "bank1", code: 0x1000, register: 0x01, manufacturer: [0, 0x10, 0, 0, 0], reaction: Reaction::None, event: None, enabled_by: None };
+        let bank1 = EmcyDefault {
+            name: "bank1",
+            code: 0x1000,
+            register: 0x01,
+            manufacturer: [0, 0x10, 0, 0, 0],
+            reaction: Reaction::None,
+            event: None,
+            enabled_by: None,
+        };
         let low = EmcyDefault { name: "low", manufacturer: [0, 0x40, 0, 0, 0], ..bank1 };
         let mut p = EmcyProducer::combining();
         p.raise(&bank1);

@@ -1,6 +1,6 @@
 //! The two mirrored banks over any two `embedded-storage` devices.
 
-use crate::record::{RECORD, Record, offset};
+use crate::record::{RECORD, Record, block_crc, offset};
 use crate::resolve::{CopyState, Verdict, resolve};
 use crate::status::BankStatus;
 use embedded_storage::Storage;
@@ -30,6 +30,12 @@ impl<const BLOCK: usize> Copy<BLOCK> {
     fn committed(data: [u8; BLOCK], seq: u8) -> Self {
         Copy { data, record: Record::committed(&data, seq), state: CopyState::Valid(seq) }
     }
+
+    /// What a format cut short leaves of a copy: zeros and their CRC with sequence 0, not yet
+    /// committed by both markers.
+    fn is_format_staged(&self) -> bool {
+        self.data.iter().all(|&b| b == 0) && self.record.crc == block_crc(&self.data, 0) && (self.record.begin, self.record.end) != (0, 0)
+    }
 }
 
 /// A block's contents once both banks agree on them.
@@ -37,6 +43,8 @@ impl<const BLOCK: usize> Copy<BLOCK> {
 struct Settled<const BLOCK: usize> {
     data: [u8; BLOCK],
     seq: u8,
+    /// Both banks now hold this copy committed (a repair, if one was needed, completed).
+    mirrored: bool,
 }
 
 /// `BLOCKS` blocks of `BLOCK` bytes, mirrored in two banks (index 0 = bank 1, written first).
@@ -62,30 +70,57 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
     const SUM_FITS: () = assert!(BLOCK * 255 <= u16::MAX as usize, "blocks above 257 bytes need wider block sums");
 
     /// Start-up: checks every block in both banks, repairs what a power cut or corruption
-    /// left behind, and formats the banks if neither holds a single valid block (blank
-    /// EEPROMs). Never fails: what cannot be repaired shows in the status and lost blocks.
+    /// left behind, and formats the banks if they are blank: no valid copy anywhere (blank
+    /// EEPROMs, or a format cut in its first phase), or every block either holds what a
+    /// format writes or is lost with only staged copies (a format cut in its second phase;
+    /// see `format`). Never fails: what cannot be repaired shows in the status and
+    /// lost blocks.
     pub fn mount(banks: [S; 2]) -> Self {
         let () = Self::SUM_FITS;
         let mut me = MirroredBanks { banks, status: [BankStatus::default(); 2], block_sums: [[0; BLOCKS]; 2], lost: [false; BLOCKS], scrub_at: 0 };
-        let mut blank = BLOCKS > 0;
+        let mut blank = true;
+        let mut format_cut = true;
         for block in 0..BLOCKS {
             let copies = [me.load(0, block), me.load(1, block)];
             blank &= copies.iter().all(|c| c.state == CopyState::Invalid);
-            let _ = me.settle(block, &copies);
+            // Decided on the settled contents, not on the losing copy: a repair cut short
+            // must not change the decision at the next mount.
+            format_cut &= match me.settle(block, &copies) {
+                Ok(settled) => settled.seq == 0 && settled.data.iter().all(|&b| b == 0),
+                Err(_) => copies.iter().all(Copy::is_format_staged),
+            };
         }
-        if blank {
+        if (blank || format_cut) && me.lost.iter().any(|&l| l) {
             me.format();
         }
         me
     }
 
-    /// Writes zeros, committed as sequence 0, to every block of both banks.
+    /// Writes zeros, committed as sequence 0, to both banks of every lost block (in blank
+    /// banks the others are formatted already, or were just repaired from a formatted copy).
+    /// Two phases, so that a power cut leaves banks the next mount formats again: first every
+    /// copy is staged (zeros and their CRC behind the invalidating mark), then every copy is
+    /// committed. A cut in the first phase leaves no valid copy anywhere; one in the second
+    /// leaves formatted blocks and lost ones with staged copies, all of them zeros.
     fn format(&mut self) {
         self.status = [BankStatus(BankStatus::CLEARED); 2];
-        for block in 0..BLOCKS {
-            for bank in 0..2 {
+        let mut markers = [[None; 2]; BLOCKS];
+        for (block, markers) in markers.iter_mut().enumerate() {
+            if !self.is_lost(block) {
+                continue;
+            }
+            for (bank, staged) in markers.iter_mut().enumerate() {
                 let current = self.load(bank, block);
-                if self.write_copy(bank, block, &current, &[0; BLOCK], 0).is_ok() {
+                let result = self.stage(bank, block, &current, &[0; BLOCK], 0);
+                self.count_written(bank, block, &[0; BLOCK], result.is_ok());
+                *staged = result.ok();
+            }
+        }
+        for (block, markers) in markers.iter().enumerate() {
+            for (bank, staged) in markers.iter().enumerate() {
+                if let Some(staged) = *staged
+                    && self.finish(bank, block, staged, 0).is_ok()
+                {
                     self.set_lost(block, false);
                 }
             }
@@ -208,6 +243,9 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
             return Err(Error::Access);
         }
         let (old, seq, current) = match self.settle(block, &copies) {
+            // A repair that failed leaves the loser holding unknown bytes: writing over it as if
+            // it were the committed copy could commit them, so the write waits for a repair.
+            Ok(s) if !s.mirrored => return Err(Error::Access),
             Ok(s) => (Some(s.data), s.seq.wrapping_add(1), [Copy::committed(s.data, s.seq); 2]),
             // Both copies lost: the block starts again from zeros, and the banks say so.
             Err(Error::Lost { .. }) => {
@@ -236,7 +274,7 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
         match resolve(a.state, b.state, a.data == b.data) {
             Verdict::Agree => {
                 self.set_lost(block, false);
-                Ok(Settled { data: a.data, seq: a.record.seq() })
+                Ok(Settled { data: a.data, seq: a.record.seq(), mirrored: true })
             }
             Verdict::Use { winner, repair, flags } => {
                 let (w, loser, l) = if winner == 0 { (a, 1, b) } else { (b, 0, a) };
@@ -244,12 +282,10 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
                     s.set(flags);
                 }
                 let seq = w.record.seq();
-                if repair {
-                    // A failed repair leaves the loser invalid; the winner is still intact.
-                    let _ = self.write_copy(loser, block, l, &w.data, seq);
-                }
+                // A failed repair leaves the loser invalid; the winner is still intact.
+                let mirrored = repair && self.write_copy(loser, block, l, &w.data, seq).is_ok();
                 self.set_lost(block, false);
-                Ok(Settled { data: w.data, seq })
+                Ok(Settled { data: w.data, seq, mirrored })
             }
             Verdict::Lost => {
                 for (s, c) in self.status.iter_mut().zip(copies) {
@@ -266,8 +302,14 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
     /// Turns `current` (what `bank` holds for `block`) into `new` committed as `seq`, in the
     /// order of [`crate::record`], writing only bytes that change.
     fn write_copy(&mut self, bank: usize, block: usize, current: &Copy<BLOCK>, new: &[u8; BLOCK], seq: u8) -> Result<(), Error> {
-        let result = self.commit(bank, block, current, new, seq);
-        if result.is_ok() {
+        let result = self.stage(bank, block, current, new, seq).and_then(|markers| self.finish(bank, block, markers, seq));
+        self.count_written(bank, block, new, result.is_ok());
+        result
+    }
+
+    /// The block sum after writing `new` into `bank`: `new` if the write completed.
+    fn count_written(&mut self, bank: usize, block: usize, new: &[u8; BLOCK], done: bool) {
+        if done {
             self.set_block_sum(bank, block, new);
         } else {
             // Some bytes may be written: count what the bank now holds, if it answers.
@@ -276,15 +318,22 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
                 self.set_block_sum(bank, block, &now);
             }
         }
-        result
     }
 
-    fn commit(&mut self, bank: usize, block: usize, current: &Copy<BLOCK>, new: &[u8; BLOCK], seq: u8) -> Result<(), Error> {
+    /// Steps 1 and 2 of [`crate::record`]: the invalidating mark, the changed data bytes and
+    /// the CRC. Returns the markers `(begin, end)` the copy then holds, for [`Self::finish`].
+    fn stage(&mut self, bank: usize, block: usize, current: &Copy<BLOCK>, new: &[u8; BLOCK], seq: u8) -> Result<(u8, u8), Error> {
         let base = Self::slot(block);
-        let mark = current.record.invalidating_mark(seq);
-        if current.record.begin != mark {
+        let (begin, end) = (current.record.begin, current.record.end);
+        // Markers that differ already make the copy invalid; a mark written over them could
+        // make it valid again, if the cut left the stored `end` in `begin`.
+        let begin = if begin == end {
+            let mark = current.record.invalidating_mark(seq);
             self.put(bank, base + offset::begin(BLOCK), &[mark])?;
-        }
+            mark
+        } else {
+            begin
+        };
         let mut run: Option<usize> = None;
         for i in 0..=BLOCK {
             let changed = i < BLOCK && new.get(i) != current.data.get(i);
@@ -301,12 +350,20 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
         if current.record.crc != record.crc {
             self.put(bank, base + offset::crc(BLOCK), &record.crc.to_le_bytes())?;
         }
-        // The commit: whichever marker does not yet say `seq` is written last.
-        if mark != seq {
-            self.put(bank, base + offset::begin(BLOCK), &[seq])
-        } else {
-            self.put(bank, base + offset::end(BLOCK), &[seq])
+        Ok((begin, end))
+    }
+
+    /// Step 3, the commit: each marker that does not yet say `seq`, `begin` first; the last
+    /// one written commits the copy.
+    fn finish(&mut self, bank: usize, block: usize, (begin, end): (u8, u8), seq: u8) -> Result<(), Error> {
+        let base = Self::slot(block);
+        if begin != seq {
+            self.put(bank, base + offset::begin(BLOCK), &[seq])?;
         }
+        if end != seq {
+            self.put(bank, base + offset::end(BLOCK), &[seq])?;
+        }
+        Ok(())
     }
 
     fn load(&mut self, bank: usize, block: usize) -> Copy<BLOCK> {

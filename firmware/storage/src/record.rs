@@ -5,17 +5,24 @@
 //! CRC matches the data and that sequence number. A write of sequence number `t` goes:
 //!
 //! 1. `begin` := a mark different from the stored `end` (normally `t` itself), so the copy
-//!    is invalid before any data byte changes;
+//!    is invalid before any data byte changes. Skipped when `begin != end` already: such a
+//!    copy is invalid, and a mark cut to the value of the stored `end` could make its stale
+//!    contents valid again;
 //! 2. the changed data bytes, then the CRC of the new data with `t`;
-//! 3. the byte that makes `begin == end == t`, which commits the copy.
+//! 3. `begin` := `t` unless it says `t`, then `end` := `t` unless it says `t`: the last byte
+//!    written makes `begin == end == t` and commits the copy (two bytes only when step 1 was
+//!    skipped and neither marker said `t`).
 //!
-//! Every state between step 1 and step 3 has `begin != end`, whatever the data or CRC bytes
-//! hold, so a cut anywhere in it reads as invalid, never as a mix that happens to match its
-//! CRC. A cut while the single byte of step 1 or step 3 is programmed leaves that byte old,
-//! new or garbage: old or garbage-equal-to-`end` at step 1 still means the complete old copy,
-//! and any value at step 3 is either the complete new copy or invalid. The CRC is there to
-//! catch later corruption (bit rot), not torn writes: CRC-16 detects every error burst of up
-//! to 16 bits, which covers any single corrupted byte.
+//! Every state between step 1 and the last byte of step 3 has `begin != end`, whatever the
+//! data or CRC bytes hold, so a cut anywhere in it reads as invalid, never as a mix that
+//! happens to match its CRC. A cut while a single marker byte is programmed leaves it old,
+//! new or garbage: old or garbage-equal-to-`end` at step 1 restores the copy as it was;
+//! garbage-equal-to-`end` at the first of two step-3 bytes makes `begin == end` but meets a
+//! CRC computed with `t`, not `end`, so the copy is invalid; any value at the commit byte is
+//! either the complete new copy or invalid. So no cut makes a copy valid unless it is the
+//! complete new copy or the copy as it was. The CRC is there to catch later corruption (bit
+//! rot), not torn writes: CRC-16 detects every error burst of up to 16 bits, which covers any
+//! single corrupted byte.
 
 use coforge_link::crc::{Crc16, CrcParams};
 

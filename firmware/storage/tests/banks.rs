@@ -1,4 +1,4 @@
-#![allow(clippy::unwrap_used)]
+#![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 //! The mirrored banks on the CO401Memory1 geometry: basic behaviour. The exhaustive power-cut
 //! and corruption searches live in `verification/`.
 
@@ -82,4 +82,51 @@ fn rewriting_stored_bytes_writes_nothing() {
     let before = banks.banks().clone();
     banks.write(0, &[3]).unwrap();
     assert_eq!(banks.banks()[0].as_bytes(), before[0].as_bytes());
+}
+
+/// A RAM EEPROM whose writes can be made to fail (an I2C device that stops acknowledging).
+#[derive(Debug, Clone, Default)]
+struct Flaky {
+    ram: RamEeprom<8448>,
+    refuse_writes: bool,
+}
+
+impl embedded_storage::ReadStorage for Flaky {
+    type Error = ();
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), ()> {
+        self.ram.read(offset, bytes).map_err(|_| ())
+    }
+    fn capacity(&self) -> usize {
+        8448
+    }
+}
+
+impl embedded_storage::Storage for Flaky {
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), ()> {
+        if self.refuse_writes {
+            return Err(());
+        }
+        self.ram.write(offset, bytes).map_err(|_| ())
+    }
+}
+
+#[test]
+fn a_write_waits_while_the_other_bank_cannot_be_repaired() {
+    let mut banks = MirroredBanks::<Flaky, 64, 128>::mount([Flaky::default(), Flaky::default()]);
+    banks.write(10, &[1]).unwrap();
+    // Bank 2's copy of block 0 goes bad, and bank 2 stops taking writes.
+    banks.banks_mut()[1].ram.as_bytes_mut()[3] ^= 0x40;
+    banks.banks_mut()[1].refuse_writes = true;
+    assert_eq!(banks.write(10, &[2]), Err(Error::Access));
+    assert!(banks.status(1).bits() & BankStatus::ACCESS_TIMEOUT != 0);
+    let mut out = [0];
+    banks.read(10, &mut out).unwrap();
+    assert_eq!(out, [1], "the committed byte, from bank 1");
+    banks.banks_mut()[1].refuse_writes = false;
+    banks.write(10, &[2]).unwrap();
+    let mut again = MirroredBanks::<Flaky, 64, 128>::mount(banks.into_banks());
+    again.read(10, &mut out).unwrap();
+    assert_eq!(out, [2]);
+    assert_eq!(again.status(0), BankStatus::default());
+    assert_eq!(again.status(1), BankStatus::default());
 }

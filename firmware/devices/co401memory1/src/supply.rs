@@ -25,7 +25,11 @@ impl Supply {
         match self {
             _ if mv < CRITICAL_MV => Supply::Critical,
             _ if mv < LOW_MV => {
-                if self == Supply::Critical && !above(CRITICAL_MV) { Supply::Critical } else { Supply::Low }
+                if self == Supply::Critical && !above(CRITICAL_MV) {
+                    Supply::Critical
+                } else {
+                    Supply::Low
+                }
             }
             Supply::Normal => Supply::Normal,
             _ if above(LOW_MV) => Supply::Normal,

@@ -72,7 +72,16 @@ pub struct NodeConfig {
 
 impl NodeConfig {
     pub const fn new(node_id: u8) -> Self {
-        NodeConfig { node_id, sdo_timeout_us: 1_000_000, startup_object: None, auto_save: false, restart_time_object: None, bootup_object: None, combine_emcy_codes: false, rpdo_deadlines: true }
+        NodeConfig {
+            node_id,
+            sdo_timeout_us: 1_000_000,
+            startup_object: None,
+            auto_save: false,
+            restart_time_object: None,
+            bootup_object: None,
+            combine_emcy_codes: false,
+            rpdo_deadlines: true,
+        }
     }
 }
 

@@ -1,0 +1,1108 @@
+//! Proof obligations of the mirrored EEPROM banks (`coforge-storage`, issue 5 §3): a power cut
+//! at any byte of a write or of start-up recovery, any single-byte corruption of either bank,
+//! the incremental bank sums, and totality for arbitrary bank contents.
+//!
+//! [`CutEeprom`] is a RAM EEPROM whose byte writes are counted on a [`Power`] supply shared by
+//! both banks, so a cut can be placed at any byte of an operation, in bank 1's part or in bank
+//! 2's. The byte being programmed at the cut keeps its old value, gets the new one or garbage
+//! ([`CutByte`]); every later write fails while reads keep working. A reboot is
+//! [`Power::restore_power`] and a new [`MirroredBanks::mount`] on the same devices.
+//!
+//! Every `check_*` function returns what it observed, so the exhaustive tests can count
+//! failures; the `prop_*` function of the same name asserts that nothing failed.
+
+use coforge_storage::record::{RECORD, Record};
+use coforge_storage::{BankStatus, Error, MirroredBanks};
+use core::cell::Cell;
+use embedded_storage::{ReadStorage, Storage};
+
+/// The banks under test: two [`CutEeprom`]s of `N` bytes, `BLOCKS` blocks of `BLOCK` bytes.
+pub type Banks<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize> = MirroredBanks<CutEeprom<'p, N>, BLOCKS, BLOCK>;
+
+/// What the byte being programmed when the power fails ends up holding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CutByte {
+    /// The cell was not yet programmed.
+    Old,
+    /// The cell was programmed; the cut hits right after it.
+    New,
+    /// The cell holds whatever the interrupted programming left.
+    Garbage(u8),
+}
+
+impl CutByte {
+    /// `selector % 3`: old, new or `garbage` (for symbolic and exhaustive inputs).
+    pub fn select(selector: u8, garbage: u8) -> CutByte {
+        match selector % 3 {
+            0 => CutByte::Old,
+            1 => CutByte::New,
+            _ => CutByte::Garbage(garbage),
+        }
+    }
+}
+
+/// The supply of both banks' EEPROMs: counts byte writes across both devices and cuts the
+/// power at a chosen one.
+#[derive(Debug)]
+pub struct Power {
+    /// Byte writes attempted since the last [`Power::arm`] or [`Power::reset_steps`].
+    steps: Cell<u32>,
+    /// The step whose byte is torn, when armed.
+    cut_at: Cell<Option<u32>>,
+    cut_byte: Cell<CutByte>,
+    off: Cell<bool>,
+    /// Where in its device the byte torn by the last cut is.
+    torn_at: Cell<Option<usize>>,
+}
+
+impl Default for Power {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Power {
+    pub const fn new() -> Power {
+        Power { steps: Cell::new(0), cut_at: Cell::new(None), cut_byte: Cell::new(CutByte::Old), off: Cell::new(false), torn_at: Cell::new(None) }
+    }
+
+    /// Cuts the power at byte write `cut_at` from now (0 = the next one), leaving `byte` in it.
+    pub fn arm(&self, cut_at: u32, byte: CutByte) {
+        self.steps.set(0);
+        self.cut_at.set(Some(cut_at));
+        self.cut_byte.set(byte);
+        self.torn_at.set(None);
+    }
+
+    /// The offset, in its device, of the byte the last cut tore.
+    pub fn torn_at(&self) -> Option<usize> {
+        self.torn_at.get()
+    }
+
+    /// Power is back and no cut is armed.
+    pub fn restore_power(&self) {
+        self.off.set(false);
+        self.cut_at.set(None);
+    }
+
+    /// The armed cut has happened.
+    pub fn is_off(&self) -> bool {
+        self.off.get()
+    }
+
+    /// Byte writes attempted (on both devices) since the last `arm` or `reset_steps`.
+    pub fn steps(&self) -> u32 {
+        self.steps.get()
+    }
+
+    pub fn reset_steps(&self) {
+        self.steps.set(0);
+    }
+
+    /// One byte write of `new` over `old` at `offset`: what the cell then holds (`None`:
+    /// untouched, the power is off), and whether the write completed.
+    fn program(&self, offset: usize, old: u8, new: u8) -> (Option<u8>, bool) {
+        if self.off.get() {
+            return (None, false);
+        }
+        let step = self.steps.get();
+        self.steps.set(step.saturating_add(1));
+        if self.cut_at.get() == Some(step) {
+            self.off.set(true);
+            self.torn_at.set(Some(offset));
+            let left = match self.cut_byte.get() {
+                CutByte::Old => old,
+                CutByte::New => new,
+                CutByte::Garbage(g) => g,
+            };
+            return (Some(left), false);
+        }
+        (Some(new), true)
+    }
+}
+
+/// Why a [`CutEeprom`] access failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EepromError {
+    OutOfBounds,
+    /// The device does not answer at all.
+    NoAnswer,
+    /// The power is off.
+    PowerCut,
+}
+
+/// `N` bytes of byte-writable memory on a shared [`Power`] supply, counting byte reads, byte
+/// writes and writes per cell.
+#[derive(Clone)]
+pub struct CutEeprom<'p, const N: usize> {
+    bytes: [u8; N],
+    power: &'p Power,
+    unreadable: bool,
+    reads: u32,
+    writes: u32,
+    /// Programming cycles of each cell (saturating).
+    cell_writes: [u16; N],
+}
+
+/// Only the contents (and whether the device answers): two devices with the same bytes debug
+/// the same whatever their counters say. The model search hashes this.
+impl<const N: usize> core::fmt::Debug for CutEeprom<'_, N> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("CutEeprom").field("bytes", &self.bytes.as_slice()).field("unreadable", &self.unreadable).finish()
+    }
+}
+
+impl<'p, const N: usize> CutEeprom<'p, N> {
+    pub fn new(power: &'p Power, bytes: [u8; N]) -> Self {
+        CutEeprom { bytes, power, unreadable: false, reads: 0, writes: 0, cell_writes: [0; N] }
+    }
+
+    /// Erased memory (every byte 0xFF).
+    pub fn erased(power: &'p Power) -> Self {
+        Self::new(power, [0xFF; N])
+    }
+
+    pub fn power(&self) -> &'p Power {
+        self.power
+    }
+
+    pub fn as_bytes(&self) -> &[u8; N] {
+        &self.bytes
+    }
+
+    /// Direct access, for corrupting a byte (no write is counted).
+    pub fn as_bytes_mut(&mut self) -> &mut [u8; N] {
+        &mut self.bytes
+    }
+
+    /// A device that answers nothing (every read and write fails).
+    pub fn set_unreadable(&mut self, unreadable: bool) {
+        self.unreadable = unreadable;
+    }
+
+    /// Power is back (the supply is shared: this restores it for both devices).
+    pub fn restore_power(&self) {
+        self.power.restore_power();
+    }
+
+    pub fn reads(&self) -> u32 {
+        self.reads
+    }
+
+    pub fn writes(&self) -> u32 {
+        self.writes
+    }
+
+    /// Programming cycles of the most-written cell since the last [`CutEeprom::reset_counts`].
+    pub fn max_cell_writes(&self) -> u16 {
+        self.cell_writes.iter().copied().max().unwrap_or(0)
+    }
+
+    pub fn cell_writes(&self, cell: usize) -> u16 {
+        self.cell_writes.get(cell).copied().unwrap_or(0)
+    }
+
+    pub fn reset_counts(&mut self) {
+        self.reads = 0;
+        self.writes = 0;
+        self.cell_writes = [0; N];
+    }
+
+    fn range(offset: u32, len: usize) -> Result<core::ops::Range<usize>, EepromError> {
+        let start = usize::try_from(offset).map_err(|_| EepromError::OutOfBounds)?;
+        let end = start.checked_add(len).filter(|&e| e <= N).ok_or(EepromError::OutOfBounds)?;
+        Ok(start..end)
+    }
+}
+
+impl<const N: usize> ReadStorage for CutEeprom<'_, N> {
+    type Error = EepromError;
+
+    /// Reads work with the power off: the test reads what a cut left before it reboots.
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), EepromError> {
+        if self.unreadable {
+            return Err(EepromError::NoAnswer);
+        }
+        let src = self.bytes.get(Self::range(offset, bytes.len())?).ok_or(EepromError::OutOfBounds)?;
+        bytes.copy_from_slice(src);
+        self.reads = self.reads.saturating_add(u32::try_from(bytes.len()).unwrap_or(u32::MAX));
+        Ok(())
+    }
+
+    fn capacity(&self) -> usize {
+        N
+    }
+}
+
+impl<const N: usize> Storage for CutEeprom<'_, N> {
+    /// Byte by byte, each one a step of the shared supply.
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), EepromError> {
+        if self.unreadable {
+            return Err(EepromError::NoAnswer);
+        }
+        let range = Self::range(offset, bytes.len())?;
+        for (i, &new) in range.zip(bytes) {
+            let (Some(cell), Some(count)) = (self.bytes.get_mut(i), self.cell_writes.get_mut(i)) else {
+                return Err(EepromError::OutOfBounds);
+            };
+            let (left, done) = self.power.program(i, *cell, new);
+            if let Some(left) = left {
+                *cell = left;
+                *count = count.saturating_add(1);
+                self.writes = self.writes.saturating_add(1);
+            }
+            if !done {
+                return Err(EepromError::PowerCut);
+            }
+        }
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading the state of the banks.
+
+/// Bytes of one block's slot in a bank.
+pub const fn slot_size(block: usize) -> usize {
+    block + RECORD
+}
+
+fn assert_geometry<const N: usize, const BLOCKS: usize, const BLOCK: usize>() {
+    assert_eq!(N, BLOCKS * slot_size(BLOCK), "an EEPROM of N bytes holds BLOCKS slots of BLOCK + 4 bytes");
+}
+
+/// Block `block`'s slot (data and record) in a bank image.
+pub fn slot<const BLOCK: usize>(image: &[u8], block: usize) -> &[u8] {
+    let start = block * slot_size(BLOCK);
+    image.get(start..start + slot_size(BLOCK)).unwrap_or(&[])
+}
+
+/// Block `block`'s copy in a bank image is committed: its record matches its data.
+pub fn copy_is_valid<const BLOCK: usize>(image: &[u8], block: usize) -> bool {
+    match slot::<BLOCK>(image, block).split_at_checked(BLOCK) {
+        Some((data, &[begin, lo, hi, end])) => Record::from_bytes([begin, lo, hi, end]).is_valid_for(data),
+        _ => false,
+    }
+}
+
+/// The sum of a bank image's data bytes, recomputed (what 5C00h must equal).
+pub fn data_sum<const BLOCKS: usize, const BLOCK: usize>(image: &[u8]) -> u32 {
+    (0..BLOCKS).map(|block| slot::<BLOCK>(image, block).iter().take(BLOCK).map(|&b| u32::from(b)).sum::<u32>()).sum()
+}
+
+/// A bank image holding `data`, each block committed with its sequence number from `seqs`.
+pub fn committed_image<const N: usize, const BLOCKS: usize, const BLOCK: usize>(data: &[[u8; BLOCK]; BLOCKS], seqs: &[u8; BLOCKS]) -> [u8; N] {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    let mut image = [0xFF; N];
+    for (block, (d, &seq)) in data.iter().zip(seqs).enumerate() {
+        let base = block * slot_size(BLOCK);
+        image[base..base + BLOCK].copy_from_slice(d);
+        image[base + BLOCK..base + slot_size(BLOCK)].copy_from_slice(&Record::committed(d, seq).to_bytes());
+    }
+    image
+}
+
+/// Two devices on `power` that both hold [`committed_image`]`(data, seqs)`: banks that agree.
+pub fn committed_devices<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    power: &'p Power,
+    data: &[[u8; BLOCK]; BLOCKS],
+    seqs: &[u8; BLOCKS],
+) -> [CutEeprom<'p, N>; 2] {
+    let image = committed_image::<N, BLOCKS, BLOCK>(data, seqs);
+    [CutEeprom::new(power, image), CutEeprom::new(power, image)]
+}
+
+/// What reading each block returns (reads repair, as they do in the device).
+pub fn contents<const N: usize, const BLOCKS: usize, const BLOCK: usize>(banks: &mut Banks<'_, N, BLOCKS, BLOCK>) -> [Result<[u8; BLOCK], Error>; BLOCKS] {
+    core::array::from_fn(|block| {
+        let mut out = [0; BLOCK];
+        banks.read(block * BLOCK, &mut out).map(|()| out)
+    })
+}
+
+/// Both bank images.
+pub fn images<const N: usize, const BLOCKS: usize, const BLOCK: usize>(banks: &Banks<'_, N, BLOCKS, BLOCK>) -> [[u8; N]; 2] {
+    let [a, b] = banks.banks();
+    [*a.as_bytes(), *b.as_bytes()]
+}
+
+/// Blocks whose slots (data and record) differ between the two banks.
+pub fn disagreeing_blocks<const N: usize, const BLOCKS: usize, const BLOCK: usize>(banks: &Banks<'_, N, BLOCKS, BLOCK>) -> usize {
+    let [a, b] = banks.banks();
+    (0..BLOCKS).filter(|&block| slot::<BLOCK>(a.as_bytes(), block) != slot::<BLOCK>(b.as_bytes(), block)).count()
+}
+
+/// Banks whose incremental sum (`checksum`) differs from a recomputation over the device.
+pub fn checksum_errors<const N: usize, const BLOCKS: usize, const BLOCK: usize>(banks: &Banks<'_, N, BLOCKS, BLOCK>) -> usize {
+    (0..2).filter(|&bank| banks.checksum(bank) != data_sum::<BLOCKS, BLOCK>(banks.banks()[bank].as_bytes())).count()
+}
+
+/// Byte writes of both devices since their counters were reset.
+pub fn writes<const N: usize, const BLOCKS: usize, const BLOCK: usize>(banks: &Banks<'_, N, BLOCKS, BLOCK>) -> u32 {
+    banks.banks().iter().map(|d| d.writes()).sum()
+}
+
+/// Byte reads of both devices since their counters were reset.
+pub fn reads<const N: usize, const BLOCKS: usize, const BLOCK: usize>(banks: &Banks<'_, N, BLOCKS, BLOCK>) -> u32 {
+    banks.banks().iter().map(|d| d.reads()).sum()
+}
+
+pub fn reset_counts<const N: usize, const BLOCKS: usize, const BLOCK: usize>(banks: &mut Banks<'_, N, BLOCKS, BLOCK>) {
+    for d in banks.banks_mut() {
+        d.reset_counts();
+    }
+}
+
+/// The new contents of every block after writing `data` at `addr` over `old` (`None` when
+/// the range is outside the data area).
+pub fn written<const BLOCKS: usize, const BLOCK: usize>(old: &[[u8; BLOCK]; BLOCKS], addr: usize, data: &[u8]) -> Option<[[u8; BLOCK]; BLOCKS]> {
+    let end = addr.checked_add(data.len()).filter(|&e| e <= BLOCKS * BLOCK)?;
+    let mut new = *old;
+    for (pos, &byte) in (addr..end).zip(data) {
+        *new.get_mut(pos / BLOCK)?.get_mut(pos % BLOCK)? = byte;
+    }
+    Some(new)
+}
+
+/// Byte writes (both devices) that writing `data` at `addr` costs from the state `devices`
+/// hold, uncut: the cut points of that write are `0..steps`.
+pub fn write_steps<const N: usize, const BLOCKS: usize, const BLOCK: usize>(devices: &[CutEeprom<'_, N>; 2], addr: usize, data: &[u8]) -> u32 {
+    let power = devices[0].power();
+    power.restore_power();
+    let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(devices.clone());
+    power.reset_steps();
+    let _ = banks.write(addr, data);
+    power.steps()
+}
+
+/// Byte writes (both devices) of an uncut mount of `devices`: the cut points of the recovery.
+pub fn recovery_steps<const N: usize, const BLOCKS: usize, const BLOCK: usize>(devices: &[CutEeprom<'_, N>; 2]) -> u32 {
+    let power = devices[0].power();
+    power.restore_power();
+    power.reset_steps();
+    let _ = Banks::<N, BLOCKS, BLOCK>::mount(devices.clone());
+    power.steps()
+}
+
+// ---------------------------------------------------------------------------------------------
+// (a) A power cut at any byte of a write.
+
+/// What a reboot after a write cut at one step found.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CutOutcome {
+    /// The cut happened before the write completed.
+    pub fired: bool,
+    /// Blocks the write changes that read back their old contents after the reboot.
+    pub old: usize,
+    /// Blocks the write changes that read back their new contents after the reboot.
+    pub new: usize,
+    /// Blocks that read back neither their old nor their new contents: a mix.
+    pub mixed: usize,
+    /// Blocks that could not be read (`Lost` or any other error).
+    pub lost: usize,
+    /// A block reads new although a block before it in the write still reads old: blocks
+    /// commit in address order.
+    pub out_of_order: usize,
+    /// The write returned `Ok` and a block still reads old: committed data lost.
+    pub committed_lost: usize,
+    /// Blocks whose two copies differ byte for byte after the reboot.
+    pub disagree: usize,
+    /// Banks whose incremental sum differs from a recomputation, after the cut (before the
+    /// reboot) and after the reboot.
+    pub checksum_errors: usize,
+    /// The write's result contradicts the cut (`Ok` although cut, or an error without a cut).
+    pub wrong_result: bool,
+}
+
+impl CutOutcome {
+    pub fn is_clean(&self) -> bool {
+        self.mixed == 0
+            && self.lost == 0
+            && self.out_of_order == 0
+            && self.committed_lost == 0
+            && self.disagree == 0
+            && self.checksum_errors == 0
+            && !self.wrong_result
+    }
+}
+
+/// Mounts `devices` (banks holding valid blocks), writes `data` at `addr` with the power cut at
+/// byte write `cut_at` (leaving `cut` in that byte), reboots, and classifies every block.
+pub fn check_write_cut<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    devices: [CutEeprom<'_, N>; 2],
+    addr: usize,
+    data: &[u8],
+    cut_at: u32,
+    cut: CutByte,
+) -> CutOutcome {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    let power = devices[0].power();
+    power.restore_power();
+    let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(devices);
+    let mut old = [[0; BLOCK]; BLOCKS];
+    for (o, c) in old.iter_mut().zip(contents(&mut banks)) {
+        *o = c.expect("precondition: every block readable before the write");
+    }
+    let new = written(&old, addr, data);
+    power.arm(cut_at, cut);
+    let result = banks.write(addr, data);
+    let fired = power.is_off();
+    let mut out = CutOutcome { fired, ..CutOutcome::default() };
+    out.wrong_result = match (fired, new.is_some()) {
+        (true, _) => result != Err(Error::Access),
+        (false, true) => result.is_err(),
+        (false, false) => result != Err(Error::OutOfRange),
+    };
+    out.checksum_errors += checksum_errors(&banks);
+    power.restore_power();
+    let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(banks.into_banks());
+    let new = new.unwrap_or(old);
+    let mut seen_old = false;
+    for ((now, o), n) in contents(&mut banks).iter().zip(&old).zip(&new) {
+        match now {
+            Err(_) => out.lost += 1,
+            Ok(now) if o == n => out.mixed += usize::from(now != o),
+            Ok(now) if now == o => {
+                out.old += 1;
+                seen_old = true;
+                out.committed_lost += usize::from(!fired);
+            }
+            Ok(now) if now == n => {
+                out.new += 1;
+                out.out_of_order += usize::from(seen_old);
+            }
+            Ok(_) => out.mixed += 1,
+        }
+    }
+    out.disagree = disagreeing_blocks(&banks);
+    out.checksum_errors += checksum_errors(&banks);
+    out
+}
+
+/// After a power cut at any byte of a write and a reboot, every block reads back exactly its
+/// old or its new contents (blocks in address order), nothing is lost, the banks agree byte
+/// for byte and the bank sums equal a recomputation.
+pub fn prop_write_cut<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    devices: [CutEeprom<'_, N>; 2],
+    addr: usize,
+    data: &[u8],
+    cut_at: u32,
+    cut: CutByte,
+) -> CutOutcome {
+    let out = check_write_cut::<N, BLOCKS, BLOCK>(devices, addr, data, cut_at, cut);
+    assert!(out.is_clean(), "write of {} bytes at {addr} cut at byte write {cut_at} ({cut:?}): {out:?}", data.len());
+    out
+}
+
+// ---------------------------------------------------------------------------------------------
+// (b) Recovery: idempotent, and safe to cut.
+
+/// What two mounts in a row did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Recovery {
+    /// Byte writes of the first mount (the repair).
+    pub repair_writes: u32,
+    /// Byte reads of the first mount.
+    pub reads: u32,
+    /// Status of both banks after the first mount.
+    pub status: [BankStatus; 2],
+    /// Blocks lost after the first mount.
+    pub lost: usize,
+}
+
+/// Mounting any bank contents twice: the second mount writes nothing, finds nothing new and
+/// leaves contents and images unchanged; after the first, every block is lost or identical
+/// and valid in both banks. Banks that already agree (identical images, every block valid)
+/// are mounted without a single write or status bit.
+pub fn prop_recovery_idempotent<const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut devices: [CutEeprom<'_, N>; 2]) -> Recovery {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    devices[0].power().restore_power();
+    let agreeing = devices[0].as_bytes() == devices[1].as_bytes() && (0..BLOCKS).all(|b| copy_is_valid::<BLOCK>(devices[0].as_bytes(), b));
+    for d in &mut devices {
+        d.reset_counts();
+    }
+    let mut first = Banks::<N, BLOCKS, BLOCK>::mount(devices);
+    let recovery = Recovery {
+        repair_writes: writes(&first),
+        reads: reads(&first),
+        status: [first.status(0), first.status(1)],
+        lost: (0..BLOCKS).filter(|&b| first.is_lost(b)).count(),
+    };
+    if agreeing {
+        assert_eq!(recovery.repair_writes, 0, "banks that agree are mounted without writes");
+        assert_eq!(recovery.status, [BankStatus::default(); 2], "banks that agree are mounted without status bits");
+    }
+    let after_first = images(&first);
+    for block in 0..BLOCKS {
+        let valid = copy_is_valid::<BLOCK>(&after_first[0], block);
+        assert!(
+            first.is_lost(block) || (valid && slot::<BLOCK>(&after_first[0], block) == slot::<BLOCK>(&after_first[1], block)),
+            "block {block} is neither lost nor settled"
+        );
+    }
+    let read_first = contents(&mut first);
+    assert_eq!(images(&first), after_first, "reads after a mount repair nothing");
+    reset_counts(&mut first);
+    let mut second = Banks::<N, BLOCKS, BLOCK>::mount(first.into_banks());
+    assert_eq!(writes(&second), 0, "a second mount writes nothing");
+    for bank in 0..2 {
+        let (s1, s2) = (recovery.status[bank].bits(), second.status(bank).bits());
+        assert_eq!(s2 & !s1, 0, "the second mount finds nothing new in bank {bank}");
+        assert_eq!(s2 & !BankStatus::CHECKSUM_ERROR, 0, "the second mount repairs nothing in bank {bank}");
+        assert_eq!(s2 != 0, recovery.lost > 0, "only lost blocks are reported again");
+    }
+    assert_eq!(images(&second), after_first);
+    assert_eq!(contents(&mut second), read_first);
+    recovery
+}
+
+/// What a recovery cut at one step and the reboot after it found, against an uncut recovery
+/// of the same contents.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RecoveryCutOutcome {
+    pub fired: bool,
+    /// Blocks that read differently from the uncut recovery.
+    pub content_differs: usize,
+    /// Blocks that an uncut recovery can read and that are lost now.
+    pub lost: usize,
+    /// The bank images differ from the uncut recovery's.
+    pub image_differs: bool,
+}
+
+impl RecoveryCutOutcome {
+    pub fn is_clean(&self) -> bool {
+        self.content_differs == 0 && self.lost == 0 && !self.image_differs
+    }
+}
+
+/// What an uncut recovery of some bank contents ends with.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Recovered<const N: usize, const BLOCKS: usize, const BLOCK: usize> {
+    pub contents: [Result<[u8; BLOCK], Error>; BLOCKS],
+    pub images: [[u8; N]; 2],
+}
+
+impl<const N: usize, const BLOCKS: usize, const BLOCK: usize> Recovered<N, BLOCKS, BLOCK> {
+    /// Mounts a copy of `devices` with the power on.
+    pub fn of(devices: &[CutEeprom<'_, N>; 2]) -> Self {
+        devices[0].power().restore_power();
+        let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(devices.clone());
+        Recovered { contents: contents(&mut banks), images: images(&banks) }
+    }
+}
+
+/// Mounts `devices` with the power cut at byte write `cut_at` of the recovery, reboots, and
+/// compares with an uncut mount of the same contents.
+pub fn check_recovery_cut<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    devices: [CutEeprom<'_, N>; 2],
+    cut_at: u32,
+    cut: CutByte,
+) -> RecoveryCutOutcome {
+    let reference = Recovered::<N, BLOCKS, BLOCK>::of(&devices);
+    check_recovery_cut_against(devices, &reference, cut_at, cut)
+}
+
+/// [`check_recovery_cut`] against a reference recovery computed once.
+pub fn check_recovery_cut_against<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    devices: [CutEeprom<'_, N>; 2],
+    reference: &Recovered<N, BLOCKS, BLOCK>,
+    cut_at: u32,
+    cut: CutByte,
+) -> RecoveryCutOutcome {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    let (expected, expected_images) = (&reference.contents, &reference.images);
+    let power = devices[0].power();
+    power.arm(cut_at, cut);
+    let cut_short = Banks::<N, BLOCKS, BLOCK>::mount(devices);
+    let fired = power.is_off();
+    power.restore_power();
+    let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(cut_short.into_banks());
+    let now = contents(&mut banks);
+    RecoveryCutOutcome {
+        fired,
+        content_differs: now.iter().zip(expected).filter(|(n, e)| n != e).count(),
+        lost: now.iter().zip(expected).filter(|(n, e)| n.is_err() && e.is_ok()).count(),
+        image_differs: images(&banks) != *expected_images,
+    }
+}
+
+/// A power cut at any byte of start-up recovery, then a reboot: the same contents and the same
+/// bank images as an uncut recovery.
+pub fn prop_recovery_cut<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    devices: [CutEeprom<'_, N>; 2],
+    cut_at: u32,
+    cut: CutByte,
+) -> RecoveryCutOutcome {
+    let out = check_recovery_cut::<N, BLOCKS, BLOCK>(devices, cut_at, cut);
+    assert!(out.is_clean(), "recovery cut at byte write {cut_at} ({cut:?}): {out:?}");
+    out
+}
+
+// ---------------------------------------------------------------------------------------------
+// (c) Corruption.
+
+/// How a corruption is looked for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Detect {
+    /// A reboot.
+    Mount,
+    /// A read of the whole affected block.
+    Read,
+    /// `check_block` of the affected block.
+    CheckBlock,
+}
+
+impl Detect {
+    pub fn select(selector: u8) -> Detect {
+        match selector % 3 {
+            0 => Detect::Mount,
+            1 => Detect::Read,
+            _ => Detect::CheckBlock,
+        }
+    }
+}
+
+/// Looks for a corruption in `block`; a `Read` returns what the read of the block returned.
+fn detect<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    mut banks: Banks<'p, N, BLOCKS, BLOCK>,
+    block: usize,
+    via: Detect,
+) -> (Banks<'p, N, BLOCKS, BLOCK>, Option<Result<[u8; BLOCK], Error>>) {
+    match via {
+        Detect::Mount => return (Banks::mount(banks.into_banks()), None),
+        Detect::Read => {
+            let mut out = [0; BLOCK];
+            let read = banks.read(block * BLOCK, &mut out).map(|()| out);
+            return (banks, Some(read));
+        }
+        Detect::CheckBlock => {
+            let _ = banks.check_block(block);
+        }
+    }
+    (banks, None)
+}
+
+/// What one single-byte corruption led to.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CorruptionOutcome {
+    /// The value differed from the stored byte (otherwise nothing was corrupted).
+    pub applied: bool,
+    /// The corrupted bank's status shows 0x10 or 0x20.
+    pub detected: bool,
+    /// The intact bank's status shows an error.
+    pub blamed_intact: bool,
+    /// Both bank images are byte for byte what they were before the corruption.
+    pub repaired: bool,
+    /// Every block reads back its contents from before the corruption.
+    pub content_kept: bool,
+    /// The bank sums equal a recomputation.
+    pub checksum_ok: bool,
+}
+
+impl CorruptionOutcome {
+    pub fn is_clean(&self) -> bool {
+        !self.applied || (self.detected && !self.blamed_intact && self.repaired && self.content_kept && self.checksum_ok)
+    }
+}
+
+/// Sets byte `pos` of bank `bank` to `value` in settled banks (identical images, every block
+/// valid, status cleared), looks for it `via`, and checks the repair. The banks come back for
+/// the next case, with the status cleared.
+pub fn check_single_corruption<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    mut banks: Banks<'p, N, BLOCKS, BLOCK>,
+    bank: usize,
+    pos: usize,
+    value: u8,
+    via: Detect,
+) -> (Banks<'p, N, BLOCKS, BLOCK>, CorruptionOutcome) {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    let (bank, pos) = (bank % 2, pos % N);
+    let block = pos / slot_size(BLOCK);
+    let before = images(&banks);
+    assert!(before[0] == before[1] && copy_is_valid::<BLOCK>(&before[0], block), "precondition: settled banks");
+    assert_eq!(banks.status(0).bits() | banks.status(1).bits(), 0, "precondition: status cleared");
+    let mut expected = [[0; BLOCK]; BLOCKS];
+    for (e, block) in expected.iter_mut().zip(0..) {
+        e.copy_from_slice(slot::<BLOCK>(&before[0], block).get(..BLOCK).unwrap_or(&[0; BLOCK]));
+    }
+    let mut out = CorruptionOutcome { applied: before[bank][pos] != value, ..CorruptionOutcome::default() };
+    banks.banks_mut()[bank].as_bytes_mut()[pos] = value;
+    let (mut banks, read) = detect(banks, block, via);
+    // A read compares the data bytes of the two banks: it must return the right data whatever
+    // was corrupted, but finds only corrupted data bytes. A record byte is left to check_block.
+    let read_right = read.is_none_or(|r| r.as_ref() == expected.get(block).ok_or(&Error::OutOfRange));
+    if via == Detect::Read && pos % slot_size(BLOCK) >= BLOCK {
+        let _ = banks.check_block(block);
+    }
+    let errors = BankStatus::CHECKSUM_ERROR | BankStatus::OVERWRITTEN;
+    out.detected = banks.status(bank).bits() & errors != 0;
+    out.blamed_intact = banks.status(1 - bank).is_error();
+    out.repaired = images(&banks) == before;
+    out.content_kept = read_right && contents(&mut banks).iter().zip(&expected).all(|(c, e)| c.as_ref() == Ok(e));
+    out.checksum_ok = checksum_errors(&banks) == 0;
+    banks.clear_status(0);
+    banks.clear_status(1);
+    (banks, out)
+}
+
+/// Any single-byte corruption of either bank (data or record) is detected on the corrupted
+/// bank, by a reboot, a read of the block or `check_block`, and repaired from the other bank:
+/// contents and both images as before, and a read in between returns the right data.
+/// (`Read` compares the data bytes of the two banks, so it finds corrupted data bytes; for a
+/// record byte the read is followed by `check_block`.)
+pub fn prop_single_corruption<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    banks: Banks<'p, N, BLOCKS, BLOCK>,
+    bank: usize,
+    pos: usize,
+    value: u8,
+    via: Detect,
+) -> Banks<'p, N, BLOCKS, BLOCK> {
+    let (banks, out) = check_single_corruption(banks, bank, pos, value, via);
+    assert!(out.is_clean(), "bank {bank} byte {pos} := {value:#04X} via {via:?}: {out:?}");
+    banks
+}
+
+/// What corrupting one block in both banks led to.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct DoubleOutcome {
+    /// Both values differed from the stored bytes.
+    pub applied: bool,
+    /// `is_lost`, `Err(Lost)` for a read of any single byte and for the whole block, and 0x10
+    /// in both banks' status.
+    pub reported_lost: bool,
+    /// A read of some byte of the block returned data.
+    pub data_returned: bool,
+    /// Every other block reads back its contents from before.
+    pub others_kept: bool,
+    /// A one-byte write restarts the block from zeros and sets 0x40 in both banks.
+    pub restarted: bool,
+}
+
+impl DoubleOutcome {
+    pub fn is_clean(&self) -> bool {
+        !self.applied || (self.reported_lost && !self.data_returned && self.others_kept && self.restarted)
+    }
+}
+
+/// Corrupts byte `offsets[i]` of block `block`'s slot in bank `i` with `values[i]` in settled
+/// banks, looks for it via a reboot or `check_block` (`Detect::Read` is taken as
+/// `check_block`), then reads every byte of the block and restarts it with a write.
+pub fn check_double_corruption<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    mut banks: Banks<'p, N, BLOCKS, BLOCK>,
+    block: usize,
+    offsets: [usize; 2],
+    values: [u8; 2],
+    via: Detect,
+) -> (Banks<'p, N, BLOCKS, BLOCK>, DoubleOutcome) {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    let block = block % BLOCKS;
+    let before = images(&banks);
+    assert!(before[0] == before[1], "precondition: settled banks");
+    let mut expected = [[0; BLOCK]; BLOCKS];
+    for (e, b) in expected.iter_mut().zip(0..) {
+        e.copy_from_slice(slot::<BLOCK>(&before[0], b).get(..BLOCK).unwrap_or(&[0; BLOCK]));
+    }
+    let mut applied = true;
+    for (bank, (offset, value)) in offsets.iter().zip(values).enumerate() {
+        let pos = block * slot_size(BLOCK) + offset % slot_size(BLOCK);
+        applied &= before[bank][pos] != value;
+        banks.banks_mut()[bank].as_bytes_mut()[pos] = value;
+    }
+    let via = if via == Detect::Mount { Detect::Mount } else { Detect::CheckBlock };
+    let (mut banks, _) = detect(banks, block, via);
+    let mut out = DoubleOutcome { applied, ..DoubleOutcome::default() };
+    let lost = Err(Error::Lost { block });
+    let mut every_read_lost = banks.read(block * BLOCK, &mut [0; BLOCK]) == lost;
+    for at in 0..BLOCK {
+        let r = banks.read(block * BLOCK + at, &mut [0]);
+        every_read_lost &= r == lost;
+        out.data_returned |= r.is_ok();
+    }
+    let flagged = (0..2).all(|b| banks.status(b).bits() & BankStatus::CHECKSUM_ERROR != 0);
+    out.reported_lost = banks.is_lost(block) && every_read_lost && flagged;
+    let now = contents(&mut banks);
+    out.others_kept = now.iter().zip(&expected).enumerate().all(|(b, (c, e))| b == block || c.as_ref() == Ok(e));
+    let mut restarted = [0; BLOCK];
+    if let Some(first) = restarted.first_mut() {
+        *first = 0xA5;
+    }
+    let write = banks.write(block * BLOCK, &restarted[..BLOCK.min(1)]);
+    let mut back = [0xEE; BLOCK];
+    let read = banks.read(block * BLOCK, &mut back);
+    let cleared = (0..2).all(|b| banks.status(b).bits() & BankStatus::CLEARED != 0);
+    out.restarted = write.is_ok() && read.is_ok() && back == restarted && cleared && !banks.is_lost(block);
+    (banks, out)
+}
+
+/// Corrupting the same block in both banks: the block is reported lost, every read of it
+/// fails with `Lost` and never returns data, other blocks are untouched, and a write restarts
+/// it from zeros.
+pub fn prop_double_corruption<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    banks: Banks<'p, N, BLOCKS, BLOCK>,
+    block: usize,
+    offsets: [usize; 2],
+    values: [u8; 2],
+    via: Detect,
+) -> Banks<'p, N, BLOCKS, BLOCK> {
+    let (banks, out) = check_double_corruption(banks, block, offsets, values, via);
+    assert!(out.is_clean(), "block {block} corrupted at {offsets:?} := {values:?} via {via:?}: {out:?}");
+    banks
+}
+
+// ---------------------------------------------------------------------------------------------
+// (d) Bank sums and (e) totality: operation sequences.
+
+/// One operation on the banks, decoded from six bytes so that Kani, the exhaustive tests and
+/// random tests can draw them: `op[0] % 7` selects it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Op {
+    /// Write `len` bytes `value, value + step, ...` at `addr` (possibly out of range).
+    Write {
+        addr: usize,
+        len: usize,
+        value: u8,
+        step: u8,
+    },
+    /// The same write, with the power cut at byte write `cut_at`, then a reboot.
+    CutWrite {
+        addr: usize,
+        len: usize,
+        value: u8,
+        cut_at: u32,
+        cut: CutByte,
+    },
+    /// Set byte `pos` of bank `bank` to `value`, then `check_block` of its block.
+    Corrupt {
+        bank: usize,
+        pos: usize,
+        value: u8,
+    },
+    Read {
+        addr: usize,
+        len: usize,
+    },
+    CheckBlock(usize),
+    Scrub,
+    Reboot,
+}
+
+/// The longest write or read of an [`Op`].
+pub const MAX_OP_LEN: usize = 256;
+
+impl Op {
+    pub fn decode<const N: usize, const BLOCKS: usize, const BLOCK: usize>(op: [u8; 6]) -> Op {
+        let [kind, a, b, c, d, e] = op;
+        let wide = usize::from(u16::from_le_bytes([a, b]));
+        // Addresses up to one past the data area, lengths up to two blocks and one byte: the
+        // out-of-range cases are drawn too.
+        let addr = wide % (BLOCKS * BLOCK + 1);
+        let len = usize::from(c) % (2 * BLOCK + 2).min(MAX_OP_LEN + 1);
+        match kind % 7 {
+            0 => Op::Write { addr, len, value: d, step: e },
+            1 => Op::CutWrite { addr, len, value: d, cut_at: u32::from(e), cut: CutByte::select(kind / 7, d ^ e) },
+            2 => Op::Corrupt { bank: usize::from(a & 1), pos: usize::from(u16::from_le_bytes([b, c])) % N, value: d },
+            3 => Op::Read { addr, len },
+            4 => Op::CheckBlock(usize::from(d) % (BLOCKS + 1)),
+            5 => Op::Scrub,
+            _ => Op::Reboot,
+        }
+    }
+}
+
+fn pattern(len: usize, value: u8, step: u8) -> [u8; MAX_OP_LEN] {
+    let mut data = [0; MAX_OP_LEN];
+    let mut v = value;
+    for d in data.iter_mut().take(len) {
+        *d = v;
+        v = v.wrapping_add(step);
+    }
+    data
+}
+
+/// Runs `op` on the banks (no assertion: [`prop_checksum_after_ops`] and [`prop_banks_total`]
+/// say what must hold after it).
+pub fn apply<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut banks: Banks<'p, N, BLOCKS, BLOCK>, op: Op) -> Banks<'p, N, BLOCKS, BLOCK> {
+    let power = banks.banks()[0].power();
+    match op {
+        Op::Write { addr, len, value, step } => {
+            let data = pattern(len, value, step);
+            let _ = banks.write(addr, data.get(..len).unwrap_or(&[]));
+        }
+        Op::CutWrite { addr, len, value, cut_at, cut } => {
+            let data = pattern(len, value, 1);
+            power.arm(cut_at, cut);
+            let _ = banks.write(addr, data.get(..len).unwrap_or(&[]));
+            power.restore_power();
+            return Banks::mount(banks.into_banks());
+        }
+        Op::Corrupt { bank, pos, value } => {
+            if let Some(byte) = banks.banks_mut().get_mut(bank).and_then(|d| d.as_bytes_mut().get_mut(pos)) {
+                *byte = value;
+            }
+            let _ = banks.check_block(pos / slot_size(BLOCK));
+        }
+        Op::Read { addr, len } => {
+            let mut out = [0; MAX_OP_LEN];
+            let _ = banks.read(addr, out.get_mut(..len).unwrap_or(&mut []));
+        }
+        Op::CheckBlock(block) => {
+            let _ = banks.check_block(block);
+        }
+        Op::Scrub => {
+            let _ = banks.scrub_next();
+        }
+        Op::Reboot => return Banks::mount(banks.into_banks()),
+    }
+    banks
+}
+
+/// After mounting any contents and after every operation of any sequence (writes, writes cut
+/// at any byte and rebooted, corruption then `check_block`, reads, checks, scrubs, reboots),
+/// the incremental sum of each bank equals the sum of its data bytes recomputed from the
+/// EEPROM. A cut write is also checked before the reboot.
+pub fn prop_checksum_after_ops<const N: usize, const BLOCKS: usize, const BLOCK: usize>(devices: [CutEeprom<'_, N>; 2], ops: &[[u8; 6]]) {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    let power = devices[0].power();
+    power.restore_power();
+    let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(devices);
+    assert_eq!(checksum_errors(&banks), 0, "after mount");
+    for (i, &bytes) in ops.iter().enumerate() {
+        let op = Op::decode::<N, BLOCKS, BLOCK>(bytes);
+        if let Op::CutWrite { addr, len, value, cut_at, cut } = op {
+            // The sums right after the cut, before the reboot.
+            let data = pattern(len, value, 1);
+            power.arm(cut_at, cut);
+            let _ = banks.write(addr, data.get(..len).unwrap_or(&[]));
+            assert_eq!(checksum_errors(&banks), 0, "right after operation {i} {op:?}");
+            power.restore_power();
+            banks = Banks::mount(banks.into_banks());
+        } else {
+            banks = apply(banks, op);
+        }
+        assert_eq!(checksum_errors(&banks), 0, "after operation {i} {op:?}");
+    }
+}
+
+/// Any bank contents, either bank possibly not answering, any operations: nothing panics.
+/// After the mount every block is lost or identical and valid in both banks (when both
+/// answer); a read of a block that is not lost succeeds; writes are refused while a bank does
+/// not answer.
+pub fn prop_banks_total<const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut devices: [CutEeprom<'_, N>; 2], unreadable: [bool; 2], ops: &[[u8; 6]]) {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    devices[0].power().restore_power();
+    for (d, u) in devices.iter_mut().zip(unreadable) {
+        d.set_unreadable(u);
+    }
+    let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(devices);
+    let both = unreadable == [false, false];
+    for block in 0..BLOCKS {
+        let [a, b] = images(&banks);
+        let settled = copy_is_valid::<BLOCK>(&a, block) && slot::<BLOCK>(&a, block) == slot::<BLOCK>(&b, block);
+        assert!(!both || banks.is_lost(block) || settled, "block {block} neither lost nor settled");
+        let read = banks.read(block * BLOCK, &mut [0; BLOCK]);
+        assert_eq!(read.is_ok(), !banks.is_lost(block), "block {block}: {read:?}");
+    }
+    if !both && BLOCKS * BLOCK > 0 {
+        assert_eq!(banks.write(0, &[0]), Err(Error::Access), "no write while a bank does not answer");
+    }
+    for &bytes in ops {
+        banks = apply(banks, Op::decode::<N, BLOCKS, BLOCK>(bytes));
+        // Out-of-range queries answer too.
+        let _ = (banks.status(2), banks.checksum(2), banks.is_lost(BLOCKS));
+        banks.clear_status(2);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Endurance and start-up cost (counts, not timings: deterministic).
+
+/// What one operation cost the two EEPROMs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Cost {
+    pub what: &'static str,
+    /// User operations measured together (the counts are totals).
+    pub operations: u32,
+    pub byte_writes: u32,
+    pub byte_reads: u32,
+    /// Programming cycles of the most-written cell (either bank) over the operations.
+    pub max_cell_writes: u16,
+}
+
+fn cost<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    what: &'static str,
+    operations: u32,
+    devices: &[CutEeprom<'p, N>; 2],
+    op: impl FnOnce(&mut Banks<'p, N, BLOCKS, BLOCK>),
+) -> Cost {
+    devices[0].power().restore_power();
+    let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(devices.clone());
+    reset_counts(&mut banks);
+    op(&mut banks);
+    let max_cell_writes = banks.banks().iter().map(|d| d.max_cell_writes()).max().unwrap_or(0);
+    Cost { what, operations, byte_writes: writes(&banks), byte_reads: reads(&banks), max_cell_writes }
+}
+
+fn mount_cost<const N: usize, const BLOCKS: usize, const BLOCK: usize>(what: &'static str, mut devices: [CutEeprom<'_, N>; 2]) -> Cost {
+    devices[0].power().restore_power();
+    for d in &mut devices {
+        d.reset_counts();
+    }
+    let banks = Banks::<N, BLOCKS, BLOCK>::mount(devices);
+    let max_cell_writes = banks.banks().iter().map(|d| d.max_cell_writes()).max().unwrap_or(0);
+    Cost { what, operations: 1, byte_writes: writes(&banks), byte_reads: reads(&banks), max_cell_writes }
+}
+
+/// The costs of writes, reads, checks and mounts, from `settled` (banks that agree, every
+/// block valid, no byte 0xA5 or 0x5A so that the writes below change every byte they touch)
+/// and `garbage` (the contents of a ruined bank). Needs `BLOCKS >= 2`.
+pub fn endurance<const N: usize, const BLOCKS: usize, const BLOCK: usize>(settled: &[CutEeprom<'_, N>; 2], garbage: &[u8; N]) -> [Cost; 13] {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    let power = settled[0].power();
+    let stored = settled[0].as_bytes()[0];
+    let changed = |i: usize, round: usize| if (i + round).is_multiple_of(2) { 0xA5 } else { 0x5A };
+    let block = core::array::from_fn::<u8, BLOCK, _>(|i| changed(i, 0));
+    let mut erased = settled.clone();
+    erased[1] = CutEeprom::erased(power);
+    let mut ruined = settled.clone();
+    *ruined[0].as_bytes_mut() = *garbage;
+    [
+        cost::<N, BLOCKS, BLOCK>("write 1 byte", 1, settled, |b| b.write(0, &[changed(0, 0)]).expect("write")),
+        cost::<N, BLOCKS, BLOCK>("write 1 byte, value already stored", 1, settled, |b| b.write(0, &[stored]).expect("write")),
+        cost::<N, BLOCKS, BLOCK>("write 1 block, every byte changed", 1, settled, |b| b.write(0, &block).expect("write")),
+        cost::<N, BLOCKS, BLOCK>("write 1 block's length across 2 blocks", 1, settled, |b| b.write(BLOCK / 2, &block).expect("write")),
+        cost::<N, BLOCKS, BLOCK>("write every block once, every byte changed", BLOCKS as u32, settled, |b| {
+            for blk in 0..BLOCKS {
+                b.write(blk * BLOCK, &block).expect("write");
+            }
+        }),
+        cost::<N, BLOCKS, BLOCK>("1000 writes of 1 byte walking through one block", 1000, settled, |b| {
+            for round in 0..1000 {
+                b.write(round % BLOCK, &[changed(round % BLOCK, round / BLOCK + 1)]).expect("write");
+            }
+        }),
+        cost::<N, BLOCKS, BLOCK>("read 1 byte", 1, settled, |b| b.read(0, &mut [0]).expect("read")),
+        cost::<N, BLOCKS, BLOCK>("read 1 block", 1, settled, |b| b.read(0, &mut [0; BLOCK]).expect("read")),
+        cost::<N, BLOCKS, BLOCK>("check_block (one scrub step)", 1, settled, |b| b.check_block(0).expect("check")),
+        mount_cost::<N, BLOCKS, BLOCK>("mount, banks agree", settled.clone()),
+        mount_cost::<N, BLOCKS, BLOCK>("mount, bank 2 erased (repair)", erased),
+        mount_cost::<N, BLOCKS, BLOCK>("mount, bank 1 garbage (repair)", ruined),
+        mount_cost::<N, BLOCKS, BLOCK>("mount, blank banks (format)", [CutEeprom::erased(power), CutEeprom::erased(power)]),
+    ]
+}
+
+/// The endurance fixture on CO401Memory1's geometry: settled banks whose data bytes are all
+/// below 0x50 (so the writes of [`endurance`] change every byte they touch), and a bank of
+/// pseudo-random garbage.
+pub fn co401memory1_fixture(power: &Power) -> ([CutEeprom<'_, 8448>; 2], [u8; 8448]) {
+    let data: [[u8; 128]; 64] = core::array::from_fn(|b| core::array::from_fn(|i| ((i * 7 + b) % 0x50) as u8));
+    let seqs: [u8; 64] = core::array::from_fn(|b| b as u8);
+    let mut garbage = [0_u8; 8448];
+    let mut x = 0x2545_F491_u32;
+    for g in &mut garbage {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        *g = (x >> 24) as u8;
+    }
+    (committed_devices::<8448, 64, 128>(power, &data, &seqs), garbage)
+}
