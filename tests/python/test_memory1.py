@@ -32,9 +32,9 @@ import tempfile
 import threading
 import time
 import types
-from dataclasses import dataclass
 
 import can
+from bus import Recorder
 import canopen
 import pytest
 import serial
@@ -101,58 +101,6 @@ def eeprom_offset(index, sub):
     """Offset of the data byte of memory object `index`, sub-index `sub` in a bank."""
     block = index - 0x5000
     return block * (BLOCK + RECORD) + sub - 1
-
-
-# --------------------------------------------------------------------------------------------
-# Every frame on the bus, with the time it arrived.
-# --------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Frame:
-    t: float
-    id: int
-    rtr: bool
-    data: bytes
-
-    def __str__(self):
-        return f"{self.id:03X}{' RTR' if self.rtr else ''} [{self.data.hex(' ')}] @{self.t:.3f}"
-
-
-class Recorder(can.Listener):
-    def __init__(self):
-        self.frames = []
-        self.cond = threading.Condition()
-
-    def on_message_received(self, msg):
-        f = Frame(time.monotonic(), msg.arbitration_id, msg.is_remote_frame, bytes(msg.data))
-        with self.cond:
-            self.frames.append(f)
-            self.cond.notify_all()
-
-    def mark(self):
-        with self.cond:
-            return len(self.frames)
-
-    def since(self, mark, cob=None):
-        with self.cond:
-            return [f for f in self.frames[mark:] if cob is None or (f.id == cob and not f.rtr)]
-
-    def wait(self, cob, mark, timeout, pred=lambda f: True):
-        """The first data frame on `cob` after `mark` that satisfies `pred`, or None."""
-        deadline = time.monotonic() + timeout
-        with self.cond:
-            i = mark
-            while True:
-                while i < len(self.frames):
-                    f = self.frames[i]
-                    i += 1
-                    if f.id == cob and not f.rtr and pred(f):
-                        return f
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    return None
-                self.cond.wait(left)
 
 
 # --------------------------------------------------------------------------------------------
