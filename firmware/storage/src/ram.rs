@@ -61,3 +61,46 @@ impl<const N: usize> Storage for RamEeprom<N> {
         Ok(())
     }
 }
+
+/// Byte-writable memory in a buffer the caller owns: an EEPROM image in a `static` that is
+/// never moved (a board's RAM banks stay in `.bss` instead of being built on the stack).
+#[derive(Debug)]
+pub struct BorrowedEeprom<'a> {
+    bytes: &'a mut [u8],
+}
+
+impl<'a> BorrowedEeprom<'a> {
+    /// Erases `bytes` to 0xFF and uses them.
+    pub fn erased(bytes: &'a mut [u8]) -> Self {
+        bytes.fill(0xFF);
+        BorrowedEeprom { bytes }
+    }
+
+    fn range(&self, offset: u32, len: usize) -> Result<core::ops::Range<usize>, OutOfBounds> {
+        let start = usize::try_from(offset).map_err(|_| OutOfBounds)?;
+        let end = start.checked_add(len).filter(|&e| e <= self.bytes.len()).ok_or(OutOfBounds)?;
+        Ok(start..end)
+    }
+}
+
+impl ReadStorage for BorrowedEeprom<'_> {
+    type Error = OutOfBounds;
+
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), OutOfBounds> {
+        let src = self.bytes.get(self.range(offset, bytes.len())?).ok_or(OutOfBounds)?;
+        bytes.copy_from_slice(src);
+        Ok(())
+    }
+
+    fn capacity(&self) -> usize {
+        self.bytes.len()
+    }
+}
+
+impl Storage for BorrowedEeprom<'_> {
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), OutOfBounds> {
+        let range = self.range(offset, bytes.len())?;
+        self.bytes.get_mut(range).ok_or(OutOfBounds)?.copy_from_slice(bytes);
+        Ok(())
+    }
+}

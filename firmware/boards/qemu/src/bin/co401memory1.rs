@@ -1,0 +1,83 @@
+//! CO401Memory1 on QEMU's lm3s6965evb: the serial host protocol on UART0, the module's CAN
+//! side as an SLCAN adapter on UART1 (frames a host sends are what the node receives, frames
+//! the node sends come back as SLCAN lines), the two EEPROM banks in RAM.
+//!
+//! ```text
+//! qemu-system-arm -machine lm3s6965evb -nographic -kernel co401memory1 \
+//!     -serial tcp:127.0.0.1:P0,server=on,wait=off,nodelay=on \
+//!     -serial tcp:127.0.0.1:P1,server=on,wait=off,nodelay=on
+//! ```
+#![no_std]
+#![no_main]
+
+use co401memory1::{BANK_SIZE, Board, Memory1, StatusOutputs};
+use coforge_board_qemu::{
+    clock,
+    uart::{UART0, UART1, Uart},
+};
+use coforge_stack::slcan::{self, Command};
+use coforge_storage::ram::BorrowedEeprom;
+use cortex_m_rt::entry;
+use panic_semihosting as _;
+
+/// The board's pins: node-ID 5 (ID0 and ID2 low), 1 Mbit/s, 9600 baud, a 24 V supply.
+struct QemuBoard;
+
+impl Board for QemuBoard {
+    fn node_id_pins(&mut self) -> u16 {
+        0x7F & !0b101
+    }
+    fn can_bitrate_pins(&mut self) -> u16 {
+        0b111
+    }
+    fn serial_bitrate_pins(&mut self) -> u16 {
+        0b111
+    }
+    fn config_pins(&mut self) -> u16 {
+        0b111
+    }
+    fn supply_mv(&mut self) -> u16 {
+        24_000
+    }
+    fn set_outputs(&mut self, _: StatusOutputs) {}
+}
+
+type Device = Memory1<BorrowedEeprom<'static>, QemuBoard>;
+
+#[entry]
+fn main() -> ! {
+    // cortex-m-rt turns these into `&'static mut` (no unsafe): the banks and the module live
+    // in .bss, and the module only borrows the banks, so nothing large is built on the stack.
+    static mut BANK1: [u8; BANK_SIZE] = [0; BANK_SIZE];
+    static mut BANK2: [u8; BANK_SIZE] = [0; BANK_SIZE];
+    static mut DEVICE: Option<Device> = None;
+    let Some(core) = cortex_m::Peripherals::take() else { panic!("peripherals taken twice") };
+    clock::start(core.SYST);
+    let (host, can) = (Uart::new(UART0), Uart::new(UART1));
+    let Ok(device) = Memory1::new([BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)], QemuBoard) else { panic!("reserved configuration pins") };
+    let device = DEVICE.insert(device);
+    device.start(0);
+    let mut lines = slcan::Decoder::new();
+    let mut answer = [0_u8; 16];
+    let mut line = [0_u8; slcan::MAX_FRAME_LINE];
+    loop {
+        let ms = clock::millis();
+        let now_us = u64::from(ms) * 1000;
+        while let Some(byte) = host.read() {
+            let n = device.on_serial_byte(byte, ms, &mut answer);
+            host.write(answer.get(..n).unwrap_or(&[]));
+        }
+        while let Some(byte) = can.read() {
+            if let Some(cmd) = lines.push(byte) {
+                if let Command::Frame(frame) = cmd {
+                    device.on_frame(&frame, now_us);
+                }
+                can.write(slcan::reply(&cmd));
+            }
+        }
+        while let Some(frame) = device.poll(now_us) {
+            let n = slcan::encode(&frame, &mut line);
+            can.write(line.get(..n).unwrap_or(&[]));
+        }
+    }
+}

@@ -1,0 +1,54 @@
+//! The lm3s6965's PL011-style UARTs, polled: a byte in when one is waiting, a byte out when
+//! the FIFO has room.
+
+/// UART0 (the first `-serial` of QEMU).
+pub const UART0: usize = 0x4000_C000;
+/// UART1 (the second `-serial`).
+pub const UART1: usize = 0x4000_D000;
+
+const DR: usize = 0x000;
+const FR: usize = 0x018;
+const LCRH: usize = 0x02C;
+const CTL: usize = 0x030;
+const FR_RXFE: u32 = 1 << 4;
+const FR_TXFF: u32 = 1 << 5;
+
+/// One UART by its base address.
+#[derive(Debug)]
+pub struct Uart {
+    base: usize,
+}
+
+impl Uart {
+    /// Enables `base` for 8N1, transmit and receive.
+    pub fn new(base: usize) -> Uart {
+        let uart = Uart { base };
+        uart.write_reg(LCRH, 0x60);
+        uart.write_reg(CTL, 0x301);
+        uart
+    }
+
+    fn read_reg(&self, offset: usize) -> u32 {
+        // SAFETY: `base` is one of the two UART blocks above and `offset` one of the register
+        // offsets of its data sheet: an aligned, always-mapped device register.
+        unsafe { core::ptr::read_volatile((self.base + offset) as *const u32) }
+    }
+
+    fn write_reg(&self, offset: usize, value: u32) {
+        // SAFETY: as in `read_reg`.
+        unsafe { core::ptr::write_volatile((self.base + offset) as *mut u32, value) }
+    }
+
+    /// A received byte, if one is waiting.
+    pub fn read(&self) -> Option<u8> {
+        (self.read_reg(FR) & FR_RXFE == 0).then(|| self.read_reg(DR) as u8)
+    }
+
+    /// Sends `bytes`, waiting for FIFO room.
+    pub fn write(&self, bytes: &[u8]) {
+        for &b in bytes {
+            while self.read_reg(FR) & FR_TXFF != 0 {}
+            self.write_reg(DR, u32::from(b));
+        }
+    }
+}
