@@ -4,6 +4,7 @@
 //! Both say what they install before they install it.
 #![forbid(unsafe_code)]
 
+mod images;
 mod setup;
 mod size;
 
@@ -106,6 +107,7 @@ fn dist() -> Result {
         return Err(format!("{failed} spec(s) have errors"));
     }
     write(&out.join("docs/index.md"), &index)?;
+    images::build()?;
     println!("xtask: dist written to {}", out.display());
     Ok(())
 }
@@ -139,10 +141,14 @@ fn test() -> Result {
     println!("xtask: [4/7] main outputs build (cargo xtask dist)");
     dist()?;
 
-    println!("xtask: [5/7] interoperability tests with python-canopen");
+    println!("xtask: [5/7] interoperability tests with python-canopen, against the simulator and the QEMU image");
+    setup::qemu()?;
+    // The raw binary `dist` wrote: the tests run exactly what would be flashed.
+    let qemu_image = root().join("target/dist/images/co401memory1-qemu.bin");
     let status = Command::new(&python)
         .args(["-m", "pytest", "-q", "tests/python"])
         .env("COFORGE_BIN", &coforge)
+        .env("COFORGE_QEMU_IMAGE", &qemu_image)
         .current_dir(root())
         .status()
         .map_err(|e| format!("cannot run pytest: {e}"))?;

@@ -57,6 +57,14 @@ fn apt_install(packages: &[&str], why: &str) -> Result {
     run(&mut install)
 }
 
+/// `qemu-system-arm`, which runs the Cortex-M3 images in the end-to-end tests.
+pub fn qemu() -> Result {
+    if output(Command::new("qemu-system-arm").arg("--version")).is_none() {
+        apt_install(&["qemu-system-arm"], "QEMU runs the lm3s6965evb firmware images in the end-to-end tests")?;
+    }
+    Ok(())
+}
+
 /// `.venv` with the Python test peers from `tests/python/requirements.txt`.
 pub fn python_venv() -> Result<PathBuf> {
     let venv = root().join(".venv");

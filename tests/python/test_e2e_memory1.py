@@ -1,0 +1,172 @@
+"""The same end-to-end test against two targets that run the same CO401Memory1 firmware logic:
+the host simulator (`coforge sim`) and the Cortex-M3 image in QEMU (lm3s6965evb, built by
+`cargo xtask test` from firmware/boards/qemu; its path comes in COFORGE_QEMU_IMAGE).
+
+python-canopen is the master over SLCAN: to the simulator's hub, or straight to the image's
+UART1, where the image is an SLCAN adapter whose bus is its own node. A serial host talks to
+the module's RS232 protocol: the simulator's --serial port, or the image's UART0.
+
+Checks: boot-up (after NMT reset node: an image that booted before anyone connected has sent
+its first boot-up into the void), SDO reads of 1000/1018/1008, SDO write and read of memory
+bytes and the bank sums, the status TPDO, the heartbeat, and the datasheet's serial examples.
+"""
+
+import os
+import pathlib
+import re
+import socket
+import subprocess
+import time
+
+import canopen
+import pytest
+
+from bus import Recorder
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
+QEMU_IMAGE = os.environ.get("COFORGE_QEMU_IMAGE", str(ROOT / "firmware/boards/qemu/target/thumbv7m-none-eabi/release/co401memory1"))
+NODE_ID = 5  # the QEMU board's ID pins; the simulator derives its pins from --node-id
+WAIT = 10.0
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def connect(port, timeout=WAIT):
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            return socket.create_connection(("127.0.0.1", port), timeout=1)
+        except OSError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.05)
+
+
+class Target:
+    """A running CO401Memory1: `can_url` for python-can, `serial` a connected socket."""
+
+    def __init__(self, kind):
+        self.kind = kind
+        if kind == "sim":
+            self.proc = subprocess.Popen(
+                [COFORGE, "sim", "co401memory1", "--node-id", str(NODE_ID), "--port", "0", "--serial", "0"],
+                stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+            )
+            serial = re.search(r"serial host on socket://[\d.]+:(\d+)", self.proc.stdout.readline())
+            can = re.search(r"on slcan (socket://\S+)", self.proc.stdout.readline())
+            assert serial and can, "coforge sim banner"
+            self.can_url, serial_port = can.group(1), int(serial.group(1))
+        else:
+            assert pathlib.Path(QEMU_IMAGE).exists(), f"no QEMU image at {QEMU_IMAGE}: run `cargo xtask test`"
+            serial_port, can_port = free_port(), free_port()
+            self.proc = subprocess.Popen(
+                ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", "none",
+                 "-semihosting-config", "enable=on,target=native", "-kernel", QEMU_IMAGE,
+                 "-serial", f"tcp:127.0.0.1:{serial_port},server=on,wait=off,nodelay=on",
+                 "-serial", f"tcp:127.0.0.1:{can_port},server=on,wait=off,nodelay=on"],
+                stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+            )
+            connect(can_port).close()  # QEMU is listening
+            self.can_url = f"socket://127.0.0.1:{can_port}"
+        self.serial = connect(serial_port)
+        self.serial.settimeout(2.0)
+        self.serial.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+
+    def close(self):
+        self.serial.close()
+        self.proc.kill()
+        self.proc.wait(timeout=10)
+
+
+@pytest.fixture(params=["sim", "qemu"])
+def target(request):
+    t = Target(request.param)
+    net = canopen.Network()
+    rec = Recorder()
+    net.listeners.insert(0, rec)
+    try:
+        net.connect(interface="slcan", channel=t.can_url, sleep_after_open=0, bitrate=1000000)
+        node = canopen.RemoteNode(NODE_ID, canopen.ObjectDictionary())
+        node.sdo.RESPONSE_TIMEOUT = 2.0
+        net.add_node(node)
+        t.net, t.node, t.rec = net, node, rec
+        yield t
+    finally:
+        net.disconnect()
+        t.close()
+
+
+def upload(t, index, sub=0):
+    return t.node.sdo.upload(index, sub)
+
+
+def download(t, index, sub, data):
+    t.node.sdo.download(index, sub, data)
+
+
+def exchange(t, request_hex, answer_len):
+    t.serial.sendall(bytes.fromhex(request_hex))
+    got = b""
+    deadline = time.monotonic() + WAIT
+    while len(got) < answer_len and time.monotonic() < deadline:
+        got += t.serial.recv(answer_len - len(got))
+    return got.hex(" ").upper()
+
+
+def test_bootup_identity_and_device_name(target):
+    mark = target.rec.mark()
+    target.net.send_message(0x000, bytes([0x81, NODE_ID]))
+    assert target.rec.wait(0x700 + NODE_ID, mark, WAIT, lambda f: f.data == b"\x00"), "boot-up after reset node"
+    assert int.from_bytes(upload(target, 0x1000), "little") == 0x00030191
+    assert int.from_bytes(upload(target, 0x1018, 1), "little") == 0x58
+    assert int.from_bytes(upload(target, 0x1018, 2), "little") == 0x01401FFE
+    assert upload(target, 0x1008) == b"CO401Memory1"
+
+
+def test_memory_bytes_and_bank_sums(target):
+    written = {(0x5000, 1): 0x11, (0x5012, 4): 0x23, (0x503F, 0x80): 0xA5}
+    for (index, sub), value in written.items():
+        download(target, index, sub, bytes([value]))
+    for (index, sub), value in written.items():
+        assert upload(target, index, sub) == bytes([value])
+    total = sum(written.values())
+    assert int.from_bytes(upload(target, 0x5C00, 1), "little") == total
+    assert int.from_bytes(upload(target, 0x5C00, 2), "little") == total
+
+
+def test_status_tpdo_and_heartbeat(target):
+    for bank in (1, 2):
+        download(target, 0x6200, bank, b"\x91")
+    download(target, 0x1017, 0, (100).to_bytes(2, "little"))
+    mark = target.rec.mark()
+    target.net.send_message(0x000, bytes([0x01, NODE_ID]))
+    tpdo = target.rec.wait(0x180 + NODE_ID, mark, 3.0)
+    assert tpdo is not None and tpdo.data == b"\x00\x00", "TPDO1 carries 6000h.1/.2"
+    time.sleep(1.0)
+    beats = [f.t for f in target.rec.since(mark, 0x700 + NODE_ID) if f.data == b"\x05"]
+    assert len(beats) >= 6, f"{len(beats)} operational heartbeats in over 1 s at 100 ms"
+    gaps = sorted(b - a for a, b in zip(beats, beats[1:]))
+    assert 0.07 <= gaps[len(gaps) // 2] <= 0.13, f"median heartbeat period {gaps[len(gaps) // 2]:.3f} s"
+
+
+def test_serial_datasheet_examples(target):
+    assert exchange(target, "00", 5) == "04 40 40 03 00"
+    assert exchange(target, "12 01 91", 2) == "11 01"
+    assert exchange(target, "44 12 50 04 23", 2) == "41 01"
+    assert exchange(target, "33 12 50 04", 3) == "32 01 23"
+    assert upload(target, 0x5012, 4) == b"\x23", "written over serial, read over SDO"
+    assert exchange(target, "83 00 23 01", 2) == "81 01"
+    target.net.send_message(0x123, bytes.fromhex("B1 B2 B3 B4 B5"))
+    deadline = time.monotonic() + WAIT
+    while (answer := exchange(target, "C0", 2)) == "C1 00" and time.monotonic() < deadline:
+        time.sleep(0.05)
+    rest = target.serial.recv(16)
+    assert (bytes.fromhex(answer) + rest).hex(" ").upper() == "C6 01 B1 B2 B3 B4 B5"
+    mark = target.rec.mark()
+    assert exchange(target, "D5 23 01 B1 B2 B3", 2) == "D1 01"
+    assert target.rec.wait(0x123, mark, WAIT, lambda f: f.data == bytes.fromhex("B1 B2 B3")), "transmitted"

@@ -1,0 +1,110 @@
+//! Firmware images: each board crate's binaries, built for the board's target and copied to
+//! `target/dist/images/<device>-<board>.elf` with a raw `.bin` for flashing.
+
+use crate::{Result, cargo, root, run};
+use std::path::PathBuf;
+
+/// A board crate and the devices it has images for.
+pub struct Board {
+    pub name: &'static str,
+    pub target: &'static str,
+    pub devices: &'static [&'static str],
+}
+
+pub const BOARDS: &[Board] = &[Board { name: "qemu", target: "thumbv7m-none-eabi", devices: &["co401memory1"] }];
+
+/// The ELF an image build leaves in the board crate's target directory.
+fn built_elf(board: &Board, device: &str) -> PathBuf {
+    root().join("firmware/boards").join(board.name).join("target").join(board.target).join("release").join(device)
+}
+
+/// Builds every image and copies it, as ELF and raw binary, to `target/dist/images`.
+pub fn build() -> Result<Vec<PathBuf>> {
+    let out = root().join("target/dist/images");
+    std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let mut images = Vec::new();
+    for board in BOARDS {
+        let dir = root().join("firmware/boards").join(board.name);
+        run(cargo().args(["build", "--quiet", "--release", "--target", board.target]).current_dir(&dir))?;
+        for device in board.devices {
+            let elf = built_elf(board, device);
+            let bytes = std::fs::read(&elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
+            let bin = raw_binary(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
+            let stem = out.join(format!("{device}-{}", board.name));
+            std::fs::write(stem.with_extension("elf"), &bytes).map_err(|e| format!("cannot write image: {e}"))?;
+            std::fs::write(stem.with_extension("bin"), &bin).map_err(|e| format!("cannot write image: {e}"))?;
+            println!("xtask: image {device} for {} ({}): {} bytes to flash", board.name, board.target, bin.len());
+            images.push(stem.with_extension("elf"));
+        }
+    }
+    Ok(images)
+}
+
+fn u16_at(b: &[u8], at: usize) -> Option<u16> {
+    Some(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?))
+}
+
+fn u32_at(b: &[u8], at: usize) -> Option<u32> {
+    Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
+}
+
+/// What a flash programmer writes: the loadable segments (PT_LOAD with file data) of a
+/// little-endian ELF32, placed at their physical (load) addresses from the lowest one, gaps
+/// filled with 0xFF (erased flash).
+pub fn raw_binary(elf: &[u8]) -> std::result::Result<Vec<u8>, String> {
+    if elf.get(..6) != Some(&[0x7F, b'E', b'L', b'F', 1, 1][..]) {
+        return Err("not a little-endian ELF32 file".into());
+    }
+    let bad = || "truncated ELF header".to_string();
+    let (phoff, phentsize, phnum) = (u32_at(elf, 28).ok_or_else(bad)? as usize, u16_at(elf, 42).ok_or_else(bad)? as usize, u16_at(elf, 44).ok_or_else(bad)?);
+    let mut segments = Vec::new();
+    for i in 0..usize::from(phnum) {
+        let ph = phoff + i * phentsize;
+        let field = |n: usize| u32_at(elf, ph + 4 * n).ok_or_else(|| format!("truncated program header {i}"));
+        let (kind, offset, paddr, filesz) = (field(0)?, field(1)? as usize, field(3)?, field(4)? as usize);
+        if kind == 1 && filesz > 0 {
+            let data = elf.get(offset..offset + filesz).ok_or_else(|| format!("segment {i} outside the file"))?;
+            segments.push((paddr, data));
+        }
+    }
+    let start = segments.iter().map(|s| s.0).min().ok_or("no loadable segment")?;
+    let end = segments.iter().map(|(a, d)| *a as usize + d.len()).max().unwrap_or(start as usize);
+    let mut bin = vec![0xFF; end - start as usize];
+    for (addr, data) in segments {
+        let at = (addr - start) as usize;
+        bin[at..at + data.len()].copy_from_slice(data);
+    }
+    Ok(bin)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::raw_binary;
+
+    /// An ELF32 header and `segments` as PT_LOAD program headers, data after them.
+    fn elf(segments: &[(u32, &[u8])]) -> Vec<u8> {
+        let mut f = vec![0x7F, b'E', b'L', b'F', 1, 1, 1];
+        f.resize(52, 0);
+        f[28..32].copy_from_slice(&52u32.to_le_bytes());
+        f[42..44].copy_from_slice(&32u16.to_le_bytes());
+        f[44..46].copy_from_slice(&(segments.len() as u16).to_le_bytes());
+        let mut data_at = 52 + 32 * segments.len();
+        let mut data = Vec::new();
+        for (paddr, bytes) in segments {
+            for v in [1, data_at as u32, *paddr, *paddr, bytes.len() as u32, bytes.len() as u32, 5, 4] {
+                f.extend_from_slice(&v.to_le_bytes());
+            }
+            data.extend_from_slice(bytes);
+            data_at += bytes.len();
+        }
+        f.extend_from_slice(&data);
+        f
+    }
+
+    #[test]
+    fn segments_land_at_their_load_addresses_with_erased_gaps() {
+        let bin = raw_binary(&elf(&[(0x0800_0004, &[3, 4]), (0x0800_0000, &[1, 2])])).unwrap();
+        assert_eq!(bin, [1, 2, 0xFF, 0xFF, 3, 4]);
+        assert!(raw_binary(b"not an elf").is_err());
+    }
+}
