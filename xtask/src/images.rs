@@ -79,6 +79,7 @@ pub fn raw_binary(elf: &[u8]) -> std::result::Result<Vec<u8>, String> {
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::unwrap_used)]
     use super::raw_binary;
 
     /// An ELF32 header and `segments` as PT_LOAD program headers, data after them.
