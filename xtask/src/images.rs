@@ -103,9 +103,81 @@ mod tests {
     }
 
     #[test]
+    fn flash_arguments_and_boards() {
+        let args = |s: &str| s.split_whitespace().map(String::from).collect::<Vec<_>>();
+        let parsed = super::flash_args(&args("--device co401memory1 --board stm32f0 --chip STM32F042K6Tx")).unwrap();
+        assert_eq!((parsed.device.as_str(), parsed.board.as_str(), parsed.chip.as_deref()), ("co401memory1", "stm32f0", Some("STM32F042K6Tx")));
+        assert!(super::flash_args(&args("--device co401memory1")).unwrap_err().contains("--board"));
+        assert!(super::flash_args(&args("--device")).unwrap_err().contains("needs a value"));
+        assert!(super::chip_of("qemu").unwrap_err().contains("QEMU"));
+        assert!(super::chip_of("nope").unwrap_err().contains("--chip"));
+    }
+
+    #[test]
     fn segments_land_at_their_load_addresses_with_erased_gaps() {
         let bin = raw_binary(&elf(&[(0x0800_0004, &[3, 4]), (0x0800_0000, &[1, 2])])).unwrap();
         assert_eq!(bin, [1, 2, 0xFF, 0xFF, 3, 4]);
         assert!(raw_binary(b"not an elf").is_err());
     }
+}
+
+/// What `cargo xtask flash` was asked.
+#[derive(Debug, PartialEq, Eq)]
+pub struct FlashArgs {
+    pub device: String,
+    pub board: String,
+    pub chip: Option<String>,
+}
+
+/// Parses `--device D --board B [--chip C]`.
+pub fn flash_args(args: &[String]) -> std::result::Result<FlashArgs, String> {
+    let mut it = args.iter();
+    let (mut device, mut board, mut chip) = (None, None, None);
+    while let Some(flag) = it.next() {
+        let slot = match flag.as_str() {
+            "--device" => &mut device,
+            "--board" => &mut board,
+            "--chip" => &mut chip,
+            other => return Err(format!("unknown argument `{other}`; usage: cargo xtask flash --device <d> --board <b> [--chip <c>]")),
+        };
+        *slot = Some(it.next().ok_or_else(|| format!("{flag} needs a value"))?.clone());
+    }
+    let device = device.ok_or("--device is required (e.g. --device co401memory1)")?;
+    let board = board.ok_or("--board is required (e.g. --board stm32f0)")?;
+    Ok(FlashArgs { device, board, chip })
+}
+
+/// The probe-rs chip name of a board that is flashed, or why it is not.
+pub fn chip_of(board: &str) -> std::result::Result<&'static str, String> {
+    match board {
+        "qemu" => Err("the qemu board's images run in QEMU, not on a probe: see \"Running an image in QEMU\" in README.md".into()),
+        other => {
+            let known: Vec<&str> = BOARDS.iter().map(|b| b.name).collect();
+            Err(format!("no board `{other}` to flash (boards: {}); pass --chip to flash an image of your own board", known.join(", ")))
+        }
+    }
+}
+
+/// `cargo xtask flash`: writes an image with `probe-rs download`.
+pub fn flash(args: &[String]) -> Result {
+    let FlashArgs { device, board, chip } = flash_args(args)?;
+    let chip = match chip {
+        Some(c) => c,
+        None => chip_of(&board)?.to_string(),
+    };
+    let elf = root().join("target/dist/images").join(format!("{device}-{board}.elf"));
+    if !elf.exists() {
+        build()?;
+    }
+    if !elf.exists() {
+        return Err(format!("no image {} after `cargo xtask dist`: is `{device}` built for board `{board}`?", elf.display()));
+    }
+    if std::process::Command::new("probe-rs").arg("--version").output().is_err() {
+        return Err(
+            "probe-rs is not installed. Install it with `cargo install probe-rs-tools --locked` (about 8 minutes on a 2-core machine), then run this again."
+                .into(),
+        );
+    }
+    run(std::process::Command::new("probe-rs").args(["download", "--chip", &chip]).arg(&elf))?;
+    run(std::process::Command::new("probe-rs").args(["reset", "--chip", &chip]))
 }

@@ -17,9 +17,10 @@ fn main() -> ExitCode {
         Some("dist") => dist(),
         Some("test") => test(),
         Some("size") => setup::rust_targets().and_then(|()| size::report()),
+        Some("flash") => images::flash(args.get(1..).unwrap_or_default()),
         _ => {
             eprintln!(
-                "usage: cargo xtask <dist|test>\n  dist  check every spec and write EDS files and docs into target/dist/\n  test  install missing tools, then run the whole test suite"
+                "usage: cargo xtask <dist|test|size|flash>\n  dist   check every spec; write EDS files, docs and firmware images into target/dist/\n  test   install missing tools, then run the whole test suite\n  size   flash and RAM of each device's generated code on a Cortex-M0\n  flash  --device <d> --board <b> [--chip <c>]: write an image with probe-rs"
             );
             return ExitCode::from(2);
         }
