@@ -2,8 +2,8 @@
 the host simulator (`coforge sim`) and the Cortex-M3 image in QEMU (lm3s6965evb, built by
 `cargo xtask test` from firmware/boards/qemu; its path comes in COFORGE_QEMU_IMAGE).
 
-python-canopen is the master over SLCAN: to the simulator's hub, or straight to the image's
-UART1, where the image is an SLCAN adapter whose bus is its own node. A serial host talks to
+python-canopen is the master over SLCAN on a hub: the simulator's own, or `coforge hub`
+connected to the image's UART1, where the image is an SLCAN adapter whose bus is its own node. A serial host talks to
 the module's RS232 protocol: the simulator's --serial port, or the image's UART0.
 
 Checks: boot-up (after NMT reset node: an image that booted before anyone connected has sent
@@ -71,16 +71,22 @@ class Target:
                  "-serial", f"tcp:127.0.0.1:{can_port},server=on,wait=off,nodelay=on"],
                 stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
             )
-            connect(can_port).close()  # QEMU is listening
-            self.can_url = f"socket://127.0.0.1:{can_port}"
+            # The simulator's hub connects to the image's UART1 (an SLCAN adapter of its own
+            # node) and python-canopen joins the hub, as it joins `coforge sim`.
+            self.hub = subprocess.Popen([COFORGE, "hub", "--port", "0", "--connect", f"127.0.0.1:{can_port}"], stdout=subprocess.PIPE, text=True)
+            hub = re.search(r"on slcan (socket://\S+)", self.hub.stdout.readline())
+            assert hub, "coforge hub banner"
+            self.can_url = hub.group(1)
         self.serial = connect(serial_port)
         self.serial.settimeout(2.0)
         self.serial.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
 
     def close(self):
         self.serial.close()
-        self.proc.kill()
-        self.proc.wait(timeout=10)
+        for proc in (getattr(self, "hub", None), self.proc):
+            if proc is not None:
+                proc.kill()
+                proc.wait(timeout=10)
 
 
 @pytest.fixture(params=["sim", "qemu"])

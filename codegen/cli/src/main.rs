@@ -91,6 +91,20 @@ enum Cmd {
         #[arg(long)]
         seconds: Option<u64>,
     },
+    /// Run an SLCAN bus hub over TCP with no simulated node, connected to SLCAN adapters such
+    /// as firmware images in QEMU (their UART as a TCP server): python-canopen joins the hub
+    /// and talks to the images as on a shared CAN bus.
+    Hub {
+        /// TCP port of the hub (0 picks a free one; the address is printed).
+        #[arg(long, default_value_t = 0)]
+        port: u16,
+        /// An SLCAN adapter to connect to (HOST:PORT); repeatable.
+        #[arg(long)]
+        connect: Vec<String>,
+        /// Stop after this many seconds (default: run until killed).
+        #[arg(long)]
+        seconds: Option<u64>,
+    },
     /// Rewrite specs in canonical formatting, or with --check report files that differ.
     Fmt {
         #[arg(long)]
@@ -230,8 +244,33 @@ fn console(running: &coforge_sim::runner::Running, deadline: Option<std::time::I
     }
 }
 
+fn hub(port: u16, adapters: &[String], seconds: Option<u64>) -> Result<ExitCode, String> {
+    let hub = coforge_sim::hub::Hub::bind(("127.0.0.1", port)).map_err(|e| format!("cannot listen on port {port}: {e}"))?;
+    for addr in adapters {
+        // An emulator may still be starting: give its UART a few seconds to listen.
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+        while let Err(e) = hub.connect(addr.as_str()) {
+            if std::time::Instant::now() > deadline {
+                return Err(format!("cannot connect to the SLCAN adapter at {addr}: {e}"));
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+    }
+    println!("coforge hub: {} adapter(s) on slcan socket://{}", adapters.len(), hub.local_addr());
+    use std::io::Write as _;
+    let _ = std::io::stdout().flush();
+    match seconds {
+        Some(s) => std::thread::sleep(std::time::Duration::from_secs(s)),
+        None => loop {
+            std::thread::park();
+        },
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 fn run(cmd: Cmd) -> Result<ExitCode, String> {
     match cmd {
+        Cmd::Hub { port, connect, seconds } => hub(port, &connect, seconds),
         Cmd::Sim { device, node_id, port, mode, store, nodes, seconds, serial } => {
             sim(SimArgs { device: &device, first_id: node_id, port, mode: mode.as_deref(), store, count: nodes, seconds, serial })
         }

@@ -220,6 +220,8 @@ pub struct Hub {
     local_addr: SocketAddr,
     stop: Arc<AtomicBool>,
     listener: Option<JoinHandle<()>>,
+    /// SLCAN adapters the hub connected to itself ([`Hub::connect`]).
+    adapters: Mutex<Vec<Client>>,
 }
 
 impl Hub {
@@ -234,12 +236,22 @@ impl Hub {
             let (bus, stop) = (Arc::clone(&bus), Arc::clone(&stop));
             thread::Builder::new().name(format!("slcan-hub {local_addr}")).spawn(move || accept_loop(&listener, &bus, &stop))?
         };
-        Ok(Hub { bus, local_addr, stop, listener: Some(accept) })
+        Ok(Hub { bus, local_addr, stop, listener: Some(accept), adapters: Mutex::new(Vec::new()) })
     }
 
     /// The address the listener is bound to.
     pub fn local_addr(&self) -> SocketAddr {
         self.local_addr
+    }
+
+    /// Connects to an SLCAN adapter listening at `addr` (a firmware image in QEMU whose UART is
+    /// a TCP server) and puts its bus on this one: frames on the hub go to the adapter as
+    /// SLCAN lines, frame lines from the adapter go on the hub. The hub is the adapter's host,
+    /// so the adapter's answers (`z`, `\r`, BELL) are read and dropped, never answered.
+    pub fn connect(&self, addr: impl ToSocketAddrs) -> io::Result<()> {
+        let client = serve(TcpStream::connect(addr)?, &self.bus, Role::Host)?;
+        lock(&self.adapters).push(client);
+        Ok(())
     }
 
     /// A new in-process node.
@@ -272,6 +284,12 @@ impl Hub {
 impl Drop for Hub {
     fn drop(&mut self) {
         self.stop.store(true, SeqCst);
+        for adapter in lock(&self.adapters).drain(..) {
+            let _ = adapter.stream.shutdown(Shutdown::Both);
+            for thread in adapter.threads {
+                let _ = thread.join();
+            }
+        }
         // Wake the blocking accept with a connection of our own.
         let mut wake = self.local_addr;
         if wake.ip().is_unspecified() {
@@ -289,7 +307,17 @@ impl Drop for Hub {
     }
 }
 
+/// Which side of the SLCAN link the hub is on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Role {
+    /// The hub is the adapter: it answers every command line (`z`, `\r`, BELL).
+    Adapter,
+    /// The hub is the host of an adapter: it takes frame lines and answers nothing.
+    Host,
+}
+
 /// A connected client: its socket (to shut it down) and its two threads.
+#[derive(Debug)]
 struct Client {
     stream: TcpStream,
     threads: [JoinHandle<()>; 2],
@@ -304,7 +332,7 @@ fn accept_loop(listener: &TcpListener, bus: &Arc<Bus>, stop: &AtomicBool) {
         match conn {
             Ok(stream) => {
                 clients.retain(|c| !c.threads.iter().all(JoinHandle::is_finished));
-                if let Ok(client) = serve(stream, bus) {
+                if let Ok(client) = serve(stream, bus, Role::Adapter) {
                     clients.push(client);
                 }
             }
@@ -322,7 +350,7 @@ fn accept_loop(listener: &TcpListener, bus: &Arc<Bus>, stop: &AtomicBool) {
     }
 }
 
-fn serve(stream: TcpStream, bus: &Arc<Bus>) -> io::Result<Client> {
+fn serve(stream: TcpStream, bus: &Arc<Bus>, role: Role) -> io::Result<Client> {
     stream.set_nodelay(true)?;
     let peer = stream.peer_addr()?;
     let (read_half, write_half) = (stream.try_clone()?, stream.try_clone()?);
@@ -332,7 +360,7 @@ fn serve(stream: TcpStream, bus: &Arc<Bus>) -> io::Result<Client> {
     let writer = thread::Builder::new().name(format!("slcan-tx {peer}")).spawn(move || write_loop(&port, write_half))?;
     let reader = {
         let bus = Arc::clone(bus);
-        thread::Builder::new().name(format!("slcan-rx {peer}")).spawn(move || read_loop(read_half, &bus, node, &reply_tx, &queued))
+        thread::Builder::new().name(format!("slcan-rx {peer}")).spawn(move || read_loop(read_half, &bus, node, role, &reply_tx, &queued))
     };
     match reader {
         Ok(reader) => Ok(Client { stream, threads: [writer, reader] }),
@@ -344,7 +372,7 @@ fn serve(stream: TcpStream, bus: &Arc<Bus>) -> io::Result<Client> {
     }
 }
 
-fn read_loop(mut stream: TcpStream, bus: &Bus, node: u64, replies: &Sender<Item>, queued: &AtomicUsize) {
+fn read_loop(mut stream: TcpStream, bus: &Bus, node: u64, role: Role, replies: &Sender<Item>, queued: &AtomicUsize) {
     let mut decoder = slcan::Decoder::new();
     let mut buf = [0u8; 4096];
     loop {
@@ -359,7 +387,9 @@ fn read_loop(mut stream: TcpStream, bus: &Bus, node: u64, replies: &Sender<Item>
             if let Command::Frame(frame) = cmd {
                 bus.route(node, frame);
             }
-            enqueue(replies, queued, Item::Reply(slcan::reply(&cmd)));
+            if role == Role::Adapter {
+                enqueue(replies, queued, Item::Reply(slcan::reply(&cmd)));
+            }
         }
     }
     // Disconnected: leave the bus; the writer sees its queue close and ends.

@@ -415,3 +415,25 @@ fn dropping_the_hub_disconnects_clients_and_keeps_ports_working() {
     a.send(data(0x080, &[]));
     assert_eq!(b.recv_timeout(WAIT), Some(data(0x080, &[])));
 }
+
+#[test]
+fn the_hub_connects_to_an_slcan_adapter_as_its_host() {
+    let hub = hub();
+    let adapter = std::net::TcpListener::bind("127.0.0.1:0").expect("bind an adapter port");
+    hub.connect(adapter.local_addr().expect("adapter address")).expect("connect to the adapter");
+    let (mut line, _) = adapter.accept().expect("the hub connects");
+    line.set_read_timeout(Some(WAIT)).expect("socket");
+    let port = hub.attach();
+    // A frame on the hub reaches the adapter as an SLCAN line.
+    port.send(data(0x605, &[0x40, 0x00, 0x10, 0x00]));
+    let mut got = vec![0; encoded(&data(0x605, &[0x40, 0x00, 0x10, 0x00])).len()];
+    line.read_exact(&mut got).expect("socket");
+    assert_eq!(got, encoded(&data(0x605, &[0x40, 0x00, 0x10, 0x00])));
+    // The adapter's acknowledge is taken silently; its frame line goes on the hub.
+    line.write_all(b"z\rt58580000000000000000\r").expect("socket");
+    let frame = port.recv_timeout(WAIT).expect("the adapter's frame on the hub");
+    assert_eq!(frame, data(0x585, &[0; 8]));
+    line.set_read_timeout(Some(QUIET)).expect("socket");
+    let mut answer = [0_u8; 8];
+    assert!(matches!(line.read(&mut answer), Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut)), "the host answers nothing");
+}
