@@ -9,12 +9,16 @@ pub struct Board {
     pub name: &'static str,
     pub target: &'static str,
     pub devices: &'static [&'static str],
+    /// The chip's flash and RAM as `(origin, length)`, what every image is checked against.
+    pub flash: (u32, u32),
+    pub ram: (u32, u32),
 }
 
-pub const BOARDS: &[Board] = &[Board { name: "qemu", target: "thumbv7m-none-eabi", devices: &["co401memory1"] }];
+pub const BOARDS: &[Board] =
+    &[Board { name: "qemu", target: "thumbv7m-none-eabi", devices: &["co401memory1"], flash: (0, 256 * 1024), ram: (0x2000_0000, 64 * 1024) }];
 
 /// The ELF an image build leaves in the board crate's target directory.
-fn built_elf(board: &Board, device: &str) -> PathBuf {
+pub(crate) fn built_elf(board: &Board, device: &str) -> PathBuf {
     root().join("firmware/boards").join(board.name).join("target").join(board.target).join("release").join(device)
 }
 
@@ -30,6 +34,7 @@ pub fn build() -> Result<Vec<PathBuf>> {
             let elf = built_elf(board, device);
             let bytes = std::fs::read(&elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
             let bin = raw_binary(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
+            check_memory_map(&bytes, board.flash, board.ram).map_err(|e| format!("{}: {e}", elf.display()))?;
             let stem = out.join(format!("{device}-{}", board.name));
             std::fs::write(stem.with_extension("elf"), &bytes).map_err(|e| format!("cannot write image: {e}"))?;
             std::fs::write(stem.with_extension("bin"), &bin).map_err(|e| format!("cannot write image: {e}"))?;
@@ -46,6 +51,64 @@ fn u16_at(b: &[u8], at: usize) -> Option<u16> {
 
 fn u32_at(b: &[u8], at: usize) -> Option<u32> {
     Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
+}
+
+/// Checks an image against its chip's memory map: the vector table at the start of flash, its
+/// initial stack pointer inside RAM, its reset vector the ELF entry point (a Thumb address),
+/// code and constants in flash, variables in RAM.
+pub fn check_memory_map(elf: &[u8], flash: (u32, u32), ram: (u32, u32)) -> std::result::Result<(), String> {
+    let inside = |(origin, len): (u32, u32), addr: u32, size: u32| addr >= origin && u64::from(addr) + u64::from(size) <= u64::from(origin) + u64::from(len);
+    let bad = || "truncated ELF header".to_string();
+    let entry = u32_at(elf, 24).ok_or_else(bad)?;
+    let (shoff, shentsize, shnum, shstrndx) = (
+        u32_at(elf, 32).ok_or_else(bad)? as usize,
+        u16_at(elf, 46).ok_or_else(bad)? as usize,
+        u16_at(elf, 48).ok_or_else(bad)?,
+        u16_at(elf, 50).ok_or_else(bad)?,
+    );
+    let section = |i: usize| -> Option<(u32, u32, u32, u32, u32)> {
+        let at = shoff + i * shentsize;
+        Some((u32_at(elf, at)?, u32_at(elf, at + 8)?, u32_at(elf, at + 12)?, u32_at(elf, at + 16)?, u32_at(elf, at + 20)?))
+    };
+    let strtab = section(usize::from(shstrndx)).ok_or("no section name table")?.3 as usize;
+    let name = |off: u32| -> String {
+        let start = strtab + off as usize;
+        let bytes = elf.get(start..).unwrap_or_default();
+        String::from_utf8_lossy(&bytes[..bytes.iter().position(|&b| b == 0).unwrap_or(0)]).into_owned()
+    };
+    let mut vectors = None;
+    for i in 0..usize::from(shnum) {
+        let (name_off, flags, addr, offset, size) = section(i).ok_or_else(|| format!("truncated section header {i}"))?;
+        const ALLOC: u32 = 0x2;
+        if flags & ALLOC == 0 || size == 0 {
+            continue;
+        }
+        let name = name(name_off);
+        let (region, what) = match name.as_str() {
+            ".vector_table" | ".text" | ".rodata" => (flash, "flash"),
+            ".data" | ".bss" | ".uninit" => (ram, "RAM"),
+            _ if name.starts_with(".ARM") => (flash, "flash"),
+            _ => continue,
+        };
+        if !inside(region, addr, size) {
+            return Err(format!("section {name} at {addr:#010x}..{:#010x} is outside {what}", u64::from(addr) + u64::from(size)));
+        }
+        if name == ".vector_table" {
+            vectors = Some((addr, offset as usize));
+        }
+    }
+    let (addr, offset) = vectors.ok_or("no .vector_table section")?;
+    if addr != flash.0 {
+        return Err(format!("the vector table is at {addr:#010x}, not at the start of flash {:#010x}", flash.0));
+    }
+    let (sp, reset) = (u32_at(elf, offset).ok_or_else(bad)?, u32_at(elf, offset + 4).ok_or_else(bad)?);
+    if !(sp > ram.0 && u64::from(sp) <= u64::from(ram.0) + u64::from(ram.1)) {
+        return Err(format!("initial stack pointer {sp:#010x} is outside RAM"));
+    }
+    if reset & 1 != 1 || reset & !1 != entry & !1 || !inside(flash, entry & !1, 2) {
+        return Err(format!("reset vector {reset:#010x} is not the Thumb entry point {entry:#010x} in flash"));
+    }
+    Ok(())
 }
 
 /// What a flash programmer writes: the loadable segments (PT_LOAD with file data) of a
@@ -100,6 +163,20 @@ mod tests {
         }
         f.extend_from_slice(&data);
         f
+    }
+
+    /// The image `cargo xtask dist` built, when there is one (the suite builds it before).
+    #[test]
+    fn the_built_qemu_image_fits_the_lm3s6965_memory_map() {
+        let board = &super::BOARDS[0];
+        let elf = super::built_elf(board, "co401memory1");
+        let Ok(bytes) = std::fs::read(&elf) else {
+            panic!("{} is missing: run `cargo xtask dist` first", elf.display());
+        };
+        super::check_memory_map(&bytes, board.flash, board.ram).unwrap();
+        // The same image against a chip whose flash is elsewhere, or whose RAM is smaller.
+        assert!(super::check_memory_map(&bytes, (0x0800_0000, 256 * 1024), board.ram).is_err());
+        assert!(super::check_memory_map(&bytes, board.flash, (0x2000_0000, 1024)).is_err());
     }
 
     #[test]

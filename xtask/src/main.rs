@@ -126,21 +126,21 @@ fn test() -> Result {
     run(cargo().args(["fmt", "--all", "--check"]))?;
     run(cargo().args(["clippy", "--quiet", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
 
-    println!("xtask: [2/7] Rust tests, and the no_std crates for the smallest target");
+    println!("xtask: [2/7] main outputs build (cargo xtask dist; the image tests read its images)");
+    dist()?;
+
+    println!("xtask: [3/7] Rust tests, and the no_std crates for the smallest target");
     run(cargo().args(["test", "--workspace"]))?;
     for krate in NO_STD_CRATES {
         run(cargo().args(["build", "--quiet", "--release", "-p", krate, "--target", "thumbv6m-none-eabi"]))?;
     }
 
-    println!("xtask: [3/7] specs: check and canonical formatting");
+    println!("xtask: [4/7] specs: check and canonical formatting");
     run(cargo().args(["build", "--quiet", "-p", "coforge"]))?;
     let coforge = root().join("target/debug/coforge");
     let spec_args: Vec<PathBuf> = specs()?;
     run(Command::new(&coforge).arg("check").args(&spec_args))?;
     run(Command::new(&coforge).args(["fmt", "--check"]).args(&spec_args))?;
-
-    println!("xtask: [4/7] main outputs build (cargo xtask dist)");
-    dist()?;
 
     println!("xtask: [5/7] interoperability tests with python-canopen, against the simulator and the QEMU image");
     setup::qemu()?;
