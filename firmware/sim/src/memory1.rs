@@ -1,46 +1,16 @@
-//! CO401Memory1 in the simulator: the real device code over two EEPROM images, on a board
-//! whose pins give the node-ID and whose supply voltage the console sets.
+//! CO401Memory1 in the simulator: the real device code over two EEPROM images, on a
+//! [`FixedBoard`] whose pins give the node-ID and whose supply voltage the console sets.
 
 use crate::devices::{SimNode, StoreAt, eeprom};
 use crate::storage::MemStorage;
-use co401memory1::{BANK_SIZE, Board, Memory1, StatusOutputs};
+use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
 use coforge_stack::frame::CanFrame;
 use coforge_stack::node::{BusState, NodeEvent};
 use coforge_stack::od::{ReadLen, SdoAbort, Side};
 use embedded_storage::{ReadStorage, Storage};
 
-/// The simulated board: pins for the node-ID, 1 Mbit/s, 9600 baud, and a settable supply.
-#[derive(Debug, Clone)]
-pub struct SimBoard {
-    node_id: u8,
-    /// The supply in mV (24 V nominal).
-    pub supply_mv: u16,
-    pub outputs: StatusOutputs,
-}
-
-impl Board for SimBoard {
-    fn node_id_pins(&mut self) -> u16 {
-        // The pins are read through an inverter: a node-ID bit of 1 is a low pin.
-        !u16::from(self.node_id) & 0x7F
-    }
-    fn can_bitrate_pins(&mut self) -> u16 {
-        0b111
-    }
-    fn serial_bitrate_pins(&mut self) -> u16 {
-        0b111
-    }
-    fn config_pins(&mut self) -> u16 {
-        0b111
-    }
-    fn supply_mv(&mut self) -> u16 {
-        self.supply_mv
-    }
-    fn set_outputs(&mut self, outputs: StatusOutputs) {
-        self.outputs = outputs;
-    }
-}
-
-pub type SimMemory1 = Memory1<MemStorage, SimBoard>;
+/// The module on a board whose pins give `--node-id` and whose supply the console sets.
+pub type SimMemory1 = Memory1<MemStorage, FixedBoard>;
 
 /// Builds the module: banks in memory, or in `<store>.bank1` and `<store>.bank2`.
 pub fn build(mode: Option<&str>, node_id: u8, store: &StoreAt) -> Result<Box<dyn SimNode>, String> {
@@ -48,8 +18,7 @@ pub fn build(mode: Option<&str>, node_id: u8, store: &StoreAt) -> Result<Box<dyn
         return Err(format!("co401memory1 has no mode `{mode}`; its modes are: {}", co401memory1::Mode::Default.name()));
     }
     let banks = [eeprom(store, BANK_SIZE, ".bank1")?, eeprom(store, BANK_SIZE, ".bank2")?];
-    let board = SimBoard { node_id, supply_mv: 24_000, outputs: StatusOutputs::default() };
-    let device = Memory1::new(banks, board).map_err(|e| format!("co401memory1: {e:?}"))?;
+    let device = Memory1::new(banks, FixedBoard::new(node_id)).map_err(|e| format!("co401memory1: {e:?}"))?;
     Ok(Box::new(device))
 }
 

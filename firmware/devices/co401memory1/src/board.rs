@@ -41,6 +41,46 @@ pub trait Board {
     fn set_outputs(&mut self, outputs: StatusOutputs);
 }
 
+/// A board with fixed pins: a node-ID (its pins set as the inverted ID0..ID6 read it), 1 Mbit/s,
+/// 9600 baud, the only defined CFG setting, and a supply reading that can be changed. The
+/// simulator, the QEMU image and the tests use it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FixedBoard {
+    pub node_id: u8,
+    /// The supply in mV (24 V nominal).
+    pub supply_mv: u16,
+    /// What the module last drove on its status outputs.
+    pub outputs: StatusOutputs,
+}
+
+impl FixedBoard {
+    pub const fn new(node_id: u8) -> Self {
+        FixedBoard { node_id, supply_mv: 24_000, outputs: StatusOutputs { mem1_error: false, mem2_error: false, new_can_data: false, voltage_low: false } }
+    }
+}
+
+impl Board for FixedBoard {
+    fn node_id_pins(&mut self) -> u16 {
+        // Read through an inverter: a node-ID bit of 1 is a low pin.
+        !u16::from(self.node_id) & 0x7F
+    }
+    fn can_bitrate_pins(&mut self) -> u16 {
+        0b111
+    }
+    fn serial_bitrate_pins(&mut self) -> u16 {
+        0b111
+    }
+    fn config_pins(&mut self) -> u16 {
+        0b111
+    }
+    fn supply_mv(&mut self) -> u16 {
+        self.supply_mv
+    }
+    fn set_outputs(&mut self, outputs: StatusOutputs) {
+        self.outputs = outputs;
+    }
+}
+
 /// The configuration the pins select at power-on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Config {

@@ -24,7 +24,7 @@ pub mod memory;
 pub mod monitor;
 pub mod supply;
 
-pub use board::{Board, Config, ConfigError, StatusOutputs};
+pub use board::{Board, Config, ConfigError, FixedBoard, StatusOutputs};
 pub use device::Memory1;
 pub use memory::{BANK_SIZE, BLOCK, BLOCKS, Banks, MemoryApp};
 

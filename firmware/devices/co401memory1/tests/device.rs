@@ -3,46 +3,18 @@
 //! datasheet example (corrected), SDO and PDO access to the memory, the bank status and its
 //! emergencies, the supply guard and CAN monitoring.
 
-use co401memory1::{BANK_SIZE, Board, ConfigError, Memory1, StatusOutputs};
+use co401memory1::{BANK_SIZE, ConfigError, FixedBoard, Memory1};
 use coforge_stack::frame::CanFrame;
 use coforge_storage::ram::RamEeprom;
 
-#[derive(Debug, Clone)]
-struct TestBoard {
-    node_id_pins: u16,
-    supply_mv: u16,
-    outputs: StatusOutputs,
-}
-
-impl Board for TestBoard {
-    fn node_id_pins(&mut self) -> u16 {
-        self.node_id_pins
-    }
-    fn can_bitrate_pins(&mut self) -> u16 {
-        0b111
-    }
-    fn serial_bitrate_pins(&mut self) -> u16 {
-        0b111
-    }
-    fn config_pins(&mut self) -> u16 {
-        0b111
-    }
-    fn supply_mv(&mut self) -> u16 {
-        self.supply_mv
-    }
-    fn set_outputs(&mut self, outputs: StatusOutputs) {
-        self.outputs = outputs;
-    }
-}
-
 type Eeprom = RamEeprom<BANK_SIZE>;
-type Dev = Memory1<Eeprom, TestBoard>;
+type Dev = Memory1<Eeprom, FixedBoard>;
 
 const NODE: u16 = 5;
 
 /// Node-ID 5 on the pins: ID0 and ID2 low.
-fn board() -> TestBoard {
-    TestBoard { node_id_pins: 0x7F & !0b101, supply_mv: 24_000, outputs: StatusOutputs::default() }
+fn board() -> FixedBoard {
+    FixedBoard::new(NODE as u8)
 }
 
 struct Rig {
@@ -152,9 +124,8 @@ fn boots_with_the_pins_node_id_and_reports_the_cleared_blank_banks() {
     assert_eq!(rig.upload(0x6000, 2), Ok(0x40));
     assert_eq!(rig.upload(0x2105, 0), Ok(0x03));
     assert!(rig.dev.board_mut().outputs.mem1_error && rig.dev.board_mut().outputs.mem2_error);
-    let mut b = board();
-    b.node_id_pins = 0x7F;
-    assert_eq!(Memory1::new([Eeprom::new(), Eeprom::new()], b).err(), Some(ConfigError::ReservedNodeId));
+    // Node-ID code 0 (every ID pin high) is reserved.
+    assert_eq!(Memory1::new([Eeprom::new(), Eeprom::new()], FixedBoard::new(0)).err(), Some(ConfigError::ReservedNodeId));
 }
 
 #[test]

@@ -10,7 +10,7 @@
 #![no_std]
 #![no_main]
 
-use co401memory1::{BANK_SIZE, Board, Memory1, StatusOutputs};
+use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
 use coforge_board_qemu::{
     clock,
     uart::{UART0, UART1, Uart},
@@ -20,29 +20,8 @@ use coforge_storage::ram::BorrowedEeprom;
 use cortex_m_rt::entry;
 use panic_semihosting as _;
 
-/// The board's pins: node-ID 5 (ID0 and ID2 low), 1 Mbit/s, 9600 baud, a 24 V supply.
-struct QemuBoard;
-
-impl Board for QemuBoard {
-    fn node_id_pins(&mut self) -> u16 {
-        0x7F & !0b101
-    }
-    fn can_bitrate_pins(&mut self) -> u16 {
-        0b111
-    }
-    fn serial_bitrate_pins(&mut self) -> u16 {
-        0b111
-    }
-    fn config_pins(&mut self) -> u16 {
-        0b111
-    }
-    fn supply_mv(&mut self) -> u16 {
-        24_000
-    }
-    fn set_outputs(&mut self, _: StatusOutputs) {}
-}
-
-type Device = Memory1<BorrowedEeprom<'static>, QemuBoard>;
+/// Node-ID 5 on the ID pins, 1 Mbit/s, 9600 baud, a 24 V supply.
+type Device = Memory1<BorrowedEeprom<'static>, FixedBoard>;
 
 #[entry]
 fn main() -> ! {
@@ -54,7 +33,9 @@ fn main() -> ! {
     let Some(core) = cortex_m::Peripherals::take() else { panic!("peripherals taken twice") };
     clock::start(core.SYST);
     let (host, can) = (Uart::new(UART0), Uart::new(UART1));
-    let Ok(device) = Memory1::new([BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)], QemuBoard) else { panic!("reserved configuration pins") };
+    let Ok(device) = Memory1::new([BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)], FixedBoard::new(5)) else {
+        panic!("reserved configuration pins")
+    };
     let device = DEVICE.insert(device);
     device.start(0);
     let mut lines = slcan::Decoder::new();
