@@ -124,6 +124,14 @@ def exchange(t, request_hex, answer_len):
     return got.hex(" ").upper()
 
 
+def read_frame(t, request_hex):
+    """Sends a request and reads one whole answer frame: CMD/LEN byte, then LEN bytes."""
+    t.serial.sendall(bytes.fromhex(request_hex))
+    head = exchange(t, "", 1)
+    length = int(head, 16) & 0x0F
+    return (head + " " + exchange(t, "", length)).strip() if length else head
+
+
 def test_bootup_identity_and_device_name(target):
     mark = target.rec.mark()
     target.net.send_message(0x000, bytes([0x81, NODE_ID]))
@@ -169,10 +177,9 @@ def test_serial_datasheet_examples(target):
     assert exchange(target, "83 00 23 01", 2) == "81 01"
     target.net.send_message(0x123, bytes.fromhex("B1 B2 B3 B4 B5"))
     deadline = time.monotonic() + WAIT
-    while (answer := exchange(target, "C0", 2)) == "C1 00" and time.monotonic() < deadline:
+    while (answer := read_frame(target, "C0")) == "C1 00" and time.monotonic() < deadline:
         time.sleep(0.05)
-    rest = target.serial.recv(16)
-    assert (bytes.fromhex(answer) + rest).hex(" ").upper() == "C6 01 B1 B2 B3 B4 B5"
+    assert answer == "C6 01 B1 B2 B3 B4 B5"
     mark = target.rec.mark()
     assert exchange(target, "D5 23 01 B1 B2 B3", 2) == "D1 01"
     assert target.rec.wait(0x123, mark, WAIT, lambda f: f.data == bytes.fromhex("B1 B2 B3")), "transmitted"
