@@ -13,6 +13,11 @@ pub struct CrcParams {
 /// CRC-16/XMODEM: what CANopenIA's host reference code uses (check value 0x31C3).
 pub const XMODEM: CrcParams = CrcParams { poly: 0x1021, init: 0, reflect_in: false, reflect_out: false, xor_out: 0 };
 
+/// The table of polynomial 0x1021 (CRC-16-CCITT), shared by every user of it: the SDO block
+/// transfer (XMODEM, start 0) and the EEPROM bank records (start 0xFFFF, see
+/// [`Crc16::update`]) cost one 512-byte table in flash, not one each.
+pub static CCITT: Crc16 = Crc16::new(XMODEM);
+
 /// One CRC step over a byte, bit by bit: the reference the table is checked against.
 pub const fn bitwise_step(poly: u16, crc: u16, byte: u8) -> u16 {
     let mut crc = crc ^ ((byte as u16) << 8);

@@ -24,7 +24,7 @@
 //! rot), not torn writes: CRC-16 detects every error burst of up to 16 bits, which covers any
 //! single corrupted byte.
 
-use coforge_link::crc::{Crc16, CrcParams};
+use coforge_link::crc::{CCITT, CrcParams};
 
 /// Bytes of the record after each block's data.
 pub const RECORD: usize = 4;
@@ -33,11 +33,10 @@ pub const RECORD: usize = 4;
 /// all-zero record is not valid, so a bank stuck at zero is not mistaken for data.
 pub const CRC_PARAMS: CrcParams = CrcParams { poly: 0x1021, init: 0xFFFF, reflect_in: false, reflect_out: false, xor_out: 0 };
 
-static CRC: Crc16 = Crc16::new(CRC_PARAMS);
-
-/// The CRC of a block's data committed with sequence number `seq`.
+/// The CRC of a block's data committed with sequence number `seq`: the shared CCITT table
+/// (same polynomial, no reflection, no final XOR) started at [`CRC_PARAMS`]'s start value.
 pub fn block_crc(data: &[u8], seq: u8) -> u16 {
-    CRC.finish(CRC.step(CRC.update(CRC.start(), data), seq))
+    CCITT.step(CCITT.update(CRC_PARAMS.init, data), seq)
 }
 
 /// A block's commit record.
@@ -106,6 +105,13 @@ mod tests {
         assert!(!r.is_valid_for(&[1, 2, 3, 5]));
         assert!(!Record { begin: 8, ..r }.is_valid_for(&data));
         assert_eq!(Record::from_bytes(r.to_bytes()), r);
+    }
+
+    #[test]
+    fn the_shared_table_gives_the_ibm_3740_crc() {
+        // The CRC-16/IBM-3740 check value; `reference` is the bitwise definition.
+        assert_eq!(CCITT.update(CRC_PARAMS.init, b"123456789"), 0x29B1);
+        assert_eq!(block_crc(&[1, 2, 3], 4), coforge_link::crc::reference(CRC_PARAMS, &[1, 2, 3, 4]));
     }
 
     #[test]

@@ -4,15 +4,13 @@
 //! upload reads each segment from the target by offset, so it needs no buffer at all and
 //! can resend any segment the client did not acknowledge.
 
-use coforge_link::crc::{Crc16, XMODEM};
+// CRC-16-CCITT, polynomial 0x1021, initial value 0 (CiA 301 7.2.4.3.16): XMODEM.
+use coforge_link::crc::CCITT as CRC;
 
 use super::command::{self, BlockSegment, Mux, SEGMENT_DATA};
 use super::segmented::{read_segment, start_upload};
 use super::{SdoTarget, Started, State, Step, too_long};
 use crate::od::SdoAbort;
-
-/// CRC-16-CCITT, polynomial 0x1021, initial value 0 (CiA 301 7.2.4.3.16): XMODEM.
-static CRC: Crc16 = Crc16::new(XMODEM);
 
 /// The largest sub-block CiA 301 allows.
 const MAX_BLKSIZE: u8 = 127;
