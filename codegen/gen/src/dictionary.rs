@@ -1,6 +1,7 @@
 //! The typed dictionary: `Od<A>` with one field per RAM/persistent object (app-backed entries
 //! go to `A: AppObjects`), `Od::new` with the spec's defaults (`$NODEID` resolved), and the
-//! `ObjectDictionary` implementation whose dispatch is a generated `match`.
+//! `ObjectDictionary` implementation: `field` is one generated `match` on the entry's dense
+//! object number, so reads and writes share one jump table and their code lives in the stack.
 
 use crate::Options;
 use crate::naming::{camel, ident as id};
@@ -13,15 +14,26 @@ use std::collections::BTreeMap;
 /// One index, merged over every mode it exists in.
 struct Slot<'a> {
     index: u16,
+    /// Dense object number ([`object_numbers`]).
+    number: u16,
     object: &'a Object,
     /// sub -> the entry (first mode wins for defaults and types).
     entries: BTreeMap<u8, &'a Entry>,
 }
 
+/// Every index of the device, in every mode, numbered densely in index order: the
+/// `EntryInfo::object` the table carries and the `field` dispatch switches on.
+pub(crate) fn object_numbers(d: &Device) -> BTreeMap<u16, u16> {
+    let indices: std::collections::BTreeSet<u16> = d.objects.iter().map(|o| o.index).collect();
+    indices.into_iter().zip(0..).collect()
+}
+
 fn slots(d: &Device) -> Vec<Slot<'_>> {
+    let numbers = object_numbers(d);
     let mut map: BTreeMap<u16, Slot<'_>> = BTreeMap::new();
     for o in &d.objects {
-        let slot = map.entry(o.index).or_insert_with(|| Slot { index: o.index, object: o, entries: BTreeMap::new() });
+        let number = numbers.get(&o.index).copied().unwrap_or_default();
+        let slot = map.entry(o.index).or_insert_with(|| Slot { index: o.index, number, object: o, entries: BTreeMap::new() });
         for e in &o.entries {
             slot.entries.entry(e.sub).or_insert(e);
         }
@@ -50,7 +62,7 @@ fn rust_type(e: &Entry, stack: &TokenStream) -> TokenStream {
     }
 }
 
-/// The initial value of an entry's field; `node_id` is in scope in `Od::new`.
+/// The spec default of an entry's field; `node_id` is in scope in `reset_area`.
 fn initial(e: &Entry, stack: &TokenStream) -> TokenStream {
     let ty = rust_type(e, stack);
     match (&e.default, e.data_type) {
@@ -97,13 +109,14 @@ fn stored(e: &Entry) -> bool {
     e.storage != Storage::App
 }
 
-/// Per index: field declarations, record structs, initialisers, and dispatch arms.
+/// Per index: field declarations, record structs, field names, dispatch arms and defaults.
 struct Parts {
     structs: Vec<TokenStream>,
     fields: Vec<TokenStream>,
-    inits: Vec<TokenStream>,
-    read_arms: Vec<TokenStream>,
-    write_arms: Vec<TokenStream>,
+    /// The field names, for `Od::new`.
+    names: Vec<Ident>,
+    /// `(object number, sub) => &mut field` arms of `field`.
+    field_arms: Vec<TokenStream>,
     /// Persistent entries, saved by 1010h.
     persist: Vec<Place>,
     /// Every stored entry (RAM and persistent): what an NMT reset sets back to its default.
@@ -113,6 +126,8 @@ struct Parts {
 /// One stored value: its index, where it lives in `Od`, its type and its default.
 #[derive(Clone)]
 struct Place {
+    /// The object index, as a number and as the literal generated code uses.
+    number: u16,
     index: TokenStream,
     place: TokenStream,
     ty: TokenStream,
@@ -120,8 +135,8 @@ struct Place {
 }
 
 impl Parts {
-    fn place(&mut self, e: &Entry, index: &TokenStream, place: TokenStream, ty: TokenStream, default: TokenStream) {
-        let p = Place { index: index.clone(), place, ty, default };
+    fn place(&mut self, e: &Entry, number: u16, place: TokenStream, ty: TokenStream, default: TokenStream) {
+        let p = Place { number, index: crate::hex(number.into(), 4), place, ty, default };
         if persistent(e) {
             self.persist.push(p.clone());
         }
@@ -134,15 +149,9 @@ fn persistent(e: &Entry) -> bool {
 }
 
 fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
-    let index = crate::hex(slot.index.into(), 4);
+    let number = crate::dec(slot.number.into());
     let o = slot.object;
-    // App-backed entries: routed by sub-index runs.
-    let app: Vec<u8> = slot.entries.values().filter(|e| !stored(e)).map(|e| e.sub).collect();
-    for (lo, hi) in ranges(&app) {
-        let (lo, hi) = (crate::dec(lo.into()), crate::dec(hi.into()));
-        parts.read_arms.push(quote!((#index, #lo..=#hi) => self.app.read(info, sub, offset, buf)));
-        parts.write_arms.push(quote!((#index, #lo..=#hi) => self.app.write(info, sub, data)));
-    }
+    // App-backed entries never reach `field`: the stack routes them by their storage class.
     let kept: Vec<&Entry> = slot.entries.values().copied().filter(|e| stored(e)).collect();
     if kept.is_empty() {
         return;
@@ -150,85 +159,89 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
     let field = id(&o.ident);
     let doc = format!(" {:04X}h {}", slot.index, o.name);
     match o.kind {
-        ObjectKind::Var | ObjectKind::Domain => plain_field(kept[0], &field, &doc, &index, stack, parts),
+        ObjectKind::Var | ObjectKind::Domain => plain_field(kept[0], &field, &doc, slot.index, &number, stack, parts),
         ObjectKind::Array => {
             let items: Vec<&Entry> = kept.iter().copied().filter(|e| e.sub > 0).collect();
             let n = items.iter().map(|e| usize::from(e.sub)).max().unwrap_or(0);
             let Some(first) = items.first() else {
                 // Only sub 0 is stored (the elements are app-backed): a plain field.
-                return plain_field(kept[0], &field, &doc, &index, stack, parts);
+                return plain_field(kept[0], &field, &doc, slot.index, &number, stack, parts);
             };
             let ty = rust_type(first, stack);
-            let zero = initial(&Entry { default: None, ..(*first).clone() }, stack);
-            let item_inits: Vec<TokenStream> =
-                (1..=n).map(|s| items.iter().find(|e| usize::from(e.sub) == s).map_or(zero.clone(), |e| initial(e, stack))).collect();
-            let sub0 = kept.iter().find(|e| e.sub == 0).map_or(quote!(0), |e| initial(e, stack));
             if let Some(e) = kept.iter().find(|e| e.sub == 0) {
-                parts.place(e, &index, quote!(self.#field.sub0), quote!(u8), initial(e, stack));
+                parts.place(e, slot.index, quote!(self.#field.sub0), quote!(u8), initial(e, stack));
             }
             for e in &items {
                 let i = crate::dec(u64::from(e.sub) - 1);
-                parts.place(e, &index, quote!(self.#field.items[#i]), ty.clone(), initial(e, stack));
+                parts.place(e, slot.index, quote!(self.#field.items[#i]), ty.clone(), initial(e, stack));
             }
             let count = crate::dec(n as u64);
             parts.fields.push(quote!(#[doc = #doc] pub #field: #stack::value::Array<#ty, #count>));
-            parts.inits.push(quote!(#field: #stack::value::Array { sub0: #sub0, items: [#(#item_inits),*] }));
-            parts.read_arms.push(quote!((#index, 0) => self.#field.sub0.read(info, offset, buf)));
-            parts.write_arms.push(quote!((#index, 0) => self.#field.sub0.write(info, data)));
-            let last = crate::dec(n as u64);
-            parts.read_arms.push(
-                quote!((#index, s @ 1..=#last) => self.#field.items.get(usize::from(s) - 1).ok_or(#stack::od::SdoAbort::NoSubIndex)?.read(info, offset, buf)),
-            );
-            parts.write_arms.push(
-                quote!((#index, s @ 1..=#last) => self.#field.items.get_mut(usize::from(s) - 1).ok_or(#stack::od::SdoAbort::NoSubIndex)?.write(info, data)),
-            );
+            parts.names.push(field.clone());
+            parts.field_arms.push(quote!((#number, 0) => &mut self.#field.sub0));
+            parts.field_arms.push(quote!((#number, s) => self.#field.items.get_mut(usize::from(s).wrapping_sub(1))?));
         }
         ObjectKind::Record => {
             let name = camel(&o.ident);
             let mut sub_fields = Vec::new();
-            let mut sub_inits = Vec::new();
             for e in &kept {
                 let f = id(&e.ident);
                 let sub = crate::dec(e.sub.into());
                 let (ty, init) = (rust_type(e, stack), initial(e, stack));
-                parts.place(e, &index, quote!(self.#field.#f), ty.clone(), init.clone());
+                parts.place(e, slot.index, quote!(self.#field.#f), ty.clone(), init);
                 let sdoc = format!(" Sub {}: {}", e.sub, e.name);
                 sub_fields.push(quote!(#[doc = #sdoc] pub #f: #ty));
-                sub_inits.push(quote!(#f: #init));
-                parts.read_arms.push(quote!((#index, #sub) => self.#field.#f.read(info, offset, buf)));
-                parts.write_arms.push(quote!((#index, #sub) => self.#field.#f.write(info, data)));
+                parts.field_arms.push(quote!((#number, #sub) => &mut self.#field.#f));
             }
             parts.structs.push(quote! {
                 #[doc = #doc]
-                #[derive(Debug, Clone, PartialEq)]
+                #[derive(Debug, Clone, PartialEq, Default)]
                 pub struct #name { #(#sub_fields),* }
             });
             parts.fields.push(quote!(#[doc = #doc] pub #field: #name));
-            parts.inits.push(quote!(#field: #name { #(#sub_inits),* }));
+            parts.names.push(field.clone());
         }
     }
 }
 
 /// A single stored entry (a VAR, or sub 0 alone) as one field.
-fn plain_field(e: &Entry, field: &Ident, doc: &str, index: &TokenStream, stack: &TokenStream, parts: &mut Parts) {
+fn plain_field(e: &Entry, field: &Ident, doc: &str, index: u16, number: &proc_macro2::Literal, stack: &TokenStream, parts: &mut Parts) {
     let (ty, init) = (rust_type(e, stack), initial(e, stack));
-    parts.place(e, index, quote!(self.#field), ty.clone(), init.clone());
+    parts.place(e, index, quote!(self.#field), ty.clone(), init);
     parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
-    parts.inits.push(quote!(#field: #init));
-    parts.read_arms.push(quote!((#index, 0) => self.#field.read(info, offset, buf)));
-    parts.write_arms.push(quote!((#index, 0) => self.#field.write(info, data)));
+    parts.names.push(field.clone());
+    parts.field_arms.push(quote!((#number, 0) => &mut self.#field));
 }
 
-/// Consecutive runs of sub-indices.
-fn ranges(subs: &[u8]) -> Vec<(u8, u8)> {
-    let mut out: Vec<(u8, u8)> = Vec::new();
-    for &s in subs {
-        match out.last_mut() {
-            Some((_, hi)) if u16::from(*hi) + 1 == u16::from(s) => *hi = s,
-            _ => out.push((s, s)),
+/// The class of an index: resets test one index per run of places in the same class, since
+/// every [`Area`](https://docs.rs/coforge-stack) is a union of whole classes.
+fn area_class(index: u16) -> u8 {
+    match index {
+        0x0000..=0x0FFF => 0,
+        0x1000..=0x1FFF => 1,
+        0x2000..=0x5FFF => 2,
+        0x6000..=0x9FFF => 3,
+        _ => 4,
+    }
+}
+
+/// `reset_area`'s body: one `if` per run of places in the same index class.
+fn reset_groups(resets: &[Place]) -> Vec<TokenStream> {
+    let mut groups: Vec<(u16, Vec<&Place>)> = Vec::new();
+    for p in resets {
+        match groups.last_mut() {
+            Some((first, places)) if area_class(*first) == area_class(p.number) => places.push(p),
+            _ => groups.push((p.number, vec![p])),
         }
     }
-    out
+    groups
+        .into_iter()
+        .map(|(_, places)| {
+            let index = &places[0].index;
+            let (targets, defaults): (Vec<&TokenStream>, Vec<&TokenStream>) = places.iter().map(|p| (&p.place, &p.default)).unzip();
+            quote!(if area.contains(#index) { #(#targets = #defaults;)* })
+        })
+        .collect()
 }
 
 pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
@@ -236,20 +249,18 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
     let mut parts = Parts {
         structs: Vec::new(),
         fields: Vec::new(),
-        inits: Vec::new(),
-        read_arms: Vec::new(),
-        write_arms: Vec::new(),
+        names: Vec::new(),
+        field_arms: Vec::new(),
         persist: Vec::new(),
         resets: Vec::new(),
     };
     for slot in slots(d) {
         slot_parts(&slot, stack, &mut parts);
     }
-    let Parts { structs, fields, inits, read_arms, write_arms, persist, resets } = parts;
+    let Parts { structs, fields, names, field_arms, persist, resets } = parts;
     let (p_index, places): (Vec<&TokenStream>, Vec<&TokenStream>) = persist.iter().map(|p| (&p.index, &p.place)).unzip();
     let types: Vec<&TokenStream> = persist.iter().map(|p| &p.ty).collect();
-    let (r_index, r_places): (Vec<&TokenStream>, Vec<&TokenStream>) = resets.iter().map(|p| (&p.index, &p.place)).unzip();
-    let r_defaults: Vec<&TokenStream> = resets.iter().map(|p| &p.default).collect();
+    let reset_groups = reset_groups(&resets);
     quote! {
         #(#structs)*
 
@@ -264,9 +275,13 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
         }
 
         impl<A: #stack::od::AppObjects> Od<A> {
-            /// The dictionary with the spec's defaults, `$NODEID` resolved for `node_id`.
+            /// The dictionary with the spec's defaults, `$NODEID` resolved for `node_id`: all
+            /// zero first, then the one place that knows the defaults, `reset_area`.
             pub fn new(mode: Mode, node_id: u8, app: A) -> Self {
-                Od { mode, app, #(#inits),* }
+                use #stack::od::Dictionary as _;
+                let mut od = Od { mode, app, #(#names: Default::default()),* };
+                od.reset_area(#stack::od::Area::ALL, node_id);
+                od
             }
 
             pub fn mode(&self) -> Mode {
@@ -312,7 +327,7 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
 
             #[allow(unused_variables)]
             fn reset_area(&mut self, area: #stack::od::Area, node_id: u8) {
-                #( if area.contains(#r_index) { #r_places = #r_defaults; } )*
+                #(#reset_groups)*
             }
 
             fn emergencies(&self) -> &'static [#stack::emcy::EmcyDefault] {
@@ -321,25 +336,23 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
         }
 
         impl<A: #stack::od::AppObjects> #stack::od::ObjectDictionary for Od<A> {
+            type App = A;
+
             fn entries(&self) -> &'static [#stack::od::EntryInfo] {
                 od::entries(self.mode)
             }
 
-            fn read_entry(&mut self, info: &#stack::od::EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<#stack::od::ReadLen, #stack::od::SdoAbort> {
-                use #stack::value::OdValue as _;
-                match (info.index, sub) {
-                    #(#read_arms,)*
-                    _ => Err(#stack::od::SdoAbort::NoObject),
-                }
+            #[allow(unreachable_patterns)]
+            fn field(&mut self, info: &#stack::od::EntryInfo, sub: u8) -> Option<&mut dyn #stack::value::OdValue> {
+                let field: &mut dyn #stack::value::OdValue = match (info.object, sub) {
+                    #(#field_arms,)*
+                    _ => return None,
+                };
+                Some(field)
             }
 
-            fn write_entry(&mut self, info: &#stack::od::EntryInfo, sub: u8, data: &[u8]) -> Result<(), #stack::od::SdoAbort> {
-                use #stack::value::OdValue as _;
-                info.check_data(data)?;
-                match (info.index, sub) {
-                    #(#write_arms,)*
-                    _ => Err(#stack::od::SdoAbort::NoObject),
-                }
+            fn app(&mut self) -> &mut A {
+                &mut self.app
             }
         }
     }

@@ -83,8 +83,9 @@ fn ident(name: &str) -> Ident {
     Ident::new(name, Span::call_site())
 }
 
-fn run_tokens(r: &Run, stack: &TokenStream, limits: &mut Vec<LimitsKey>) -> TokenStream {
+fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<LimitsKey>) -> TokenStream {
     let Run { index, sub, last_sub, meta: m } = r;
+    let object = crate::dec(object.into());
     let index = crate::hex((*index).into(), 4);
     let (sub, last_sub) = (crate::dec((*sub).into()), crate::dec((*last_sub).into()));
     let data_type = ident(&format!("{:?}", m.data_type));
@@ -113,6 +114,7 @@ fn run_tokens(r: &Run, stack: &TokenStream, limits: &mut Vec<LimitsKey>) -> Toke
     quote! {
         #stack::od::EntryInfo {
             index: #index,
+            object: #object,
             sub: #sub,
             last_sub: #last_sub,
             data_type: #stack::od::DataType::#data_type,
@@ -133,11 +135,12 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let mut limits: Vec<LimitsKey> = Vec::new();
     let mut tables = Vec::new();
     let mut per_mode = Vec::new();
+    let numbers = crate::dictionary::object_numbers(d);
     for (variant, mode) in &modes.variants {
         let runs = runs(d, mode.as_deref());
         let count = crate::dec(runs.len() as u64);
         let table = format_ident!("ENTRIES_{}", variant.to_string().to_uppercase());
-        let items: Vec<TokenStream> = runs.iter().map(|r| run_tokens(r, stack, &mut limits)).collect();
+        let items: Vec<TokenStream> = runs.iter().map(|r| run_tokens(r, numbers.get(&r.index).copied().unwrap_or_default(), stack, &mut limits)).collect();
         tables.push(quote! { static #table: [#stack::od::EntryInfo; #count] = [#(#items),*]; });
         per_mode.push(quote!(&#table));
     }

@@ -6,6 +6,8 @@
 
 pub use coforge_types::{Access, DataType, HostAccess, NmtState, Storage};
 
+use crate::value::OdValue;
+
 /// CiA 301 SDO abort codes (table 22).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[repr(u32)]
@@ -147,6 +149,9 @@ pub struct Limits {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EntryInfo {
     pub index: u16,
+    /// The number of the object in the generated dictionary, dense from 0 and the same in
+    /// every mode: what its field dispatch switches on, so the switch is a jump table.
+    pub object: u16,
     /// First sub-index this description covers.
     pub sub: u8,
     /// Last sub-index this description covers (equal to `sub` for a single entry).
@@ -321,20 +326,41 @@ pub fn find_run(entries: &[EntryInfo], index: u16, sub: u8) -> Result<usize, Sdo
 
 /// The dictionary of one device: implemented by the code `device!` generates.
 ///
-/// The generated code provides the table and the typed dispatch (`read_entry`,
-/// `write_entry`); lookups and access checks are the provided methods, so every device
-/// refuses the same accesses with the same codes.
+/// The generated code provides the table and the field of each stored entry (`field`);
+/// reads, writes, lookups and access checks are the provided methods, so every device
+/// refuses the same accesses with the same codes and the dispatch code exists once.
 pub trait ObjectDictionary {
+    /// Where app-backed entries (`storage: app`) are read and written.
+    type App: AppObjects;
+
     /// Every entry description, sorted by index and sub-index (see [`find`]).
     fn entries(&self) -> &'static [EntryInfo];
 
+    /// The field that stores `sub` of the entry `info` describes; `None` for an entry the
+    /// dictionary does not store (app-backed ones).
+    fn field(&mut self, info: &EntryInfo, sub: u8) -> Option<&mut dyn OdValue>;
+
+    /// The device's app-backed objects.
+    fn app(&mut self) -> &mut Self::App;
+
     /// Reads the value of the entry `info` describes, at `sub`, from byte `offset` into
     /// `buf`: no lookup and no access check (the caller made both).
-    fn read_entry(&mut self, info: &EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
+    fn read_entry(&mut self, info: &EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        if info.storage == Storage::App {
+            return self.app().read(info, sub, offset, buf);
+        }
+        self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.read(info, offset, buf)
+    }
 
     /// Writes `data` (the whole value, little-endian) after its length and value checks; no
     /// lookup and no access check. A refused write leaves the stored value unchanged.
-    fn write_entry(&mut self, info: &EntryInfo, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
+    fn write_entry(&mut self, info: &EntryInfo, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        info.check_data(data)?;
+        if info.storage == Storage::App {
+            return self.app().write(info, sub, data);
+        }
+        self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.write(info, data)
+    }
 
     /// The entry's metadata, or `NoObject` / `NoSubIndex`.
     fn entry(&self, index: u16, sub: u8) -> Result<&'static EntryInfo, SdoAbort> {
@@ -359,8 +385,11 @@ pub trait ObjectDictionary {
 /// A range of object indices: what 1010h/1011h sub-indices and NMT resets act on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Area {
-    pub first: u16,
-    pub last: u16,
+    // Private: every area is one of the constants below, a union of whole index classes
+    // (0000h..0FFFh, communication, manufacturer, application, A000h..FFFFh). Generated resets
+    // test one index per run of a class and rely on that.
+    first: u16,
+    last: u16,
 }
 
 impl Area {
@@ -436,6 +465,7 @@ impl AppObjects for NoAppObjects {
 pub(crate) const fn test_entry(data_type: DataType, access: Access, host_access: HostAccess, size: u16) -> EntryInfo {
     EntryInfo {
         index: 0x2000,
+        object: 0,
         sub: 0,
         last_sub: 0,
         data_type,

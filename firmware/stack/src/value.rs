@@ -86,6 +86,13 @@ impl<const N: usize> Bytes<N> {
     }
 }
 
+/// Empty: what a generated dictionary starts from before it sets the spec's defaults.
+impl<const N: usize> Default for Bytes<N> {
+    fn default() -> Self {
+        Bytes { bytes: [0; N], len: 0 }
+    }
+}
+
 impl<const N: usize> OdValue for Bytes<N> {
     fn read(&self, _: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
         read_slice(self.as_bytes(), offset, buf)
@@ -149,6 +156,13 @@ mod tests {
 pub struct Array<T, const N: usize> {
     pub sub0: u8,
     pub items: [T; N],
+}
+
+/// All zero (`[T; N]: Default` stops at 32 elements).
+impl<T: Default + Copy, const N: usize> Default for Array<T, N> {
+    fn default() -> Self {
+        Array { sub0: 0, items: [T::default(); N] }
+    }
 }
 
 /// A field's fixed-size image in the 1010h/1011h store: what `save` writes, `load` reads.
