@@ -246,6 +246,7 @@ fn reset_groups(resets: &[Place]) -> Vec<TokenStream> {
 
 pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
     let stack = &options.stack;
+    let block_transfer = d.identity.sdo_block_transfer;
     let mut parts = Parts {
         structs: Vec::new(),
         fields: Vec::new(),
@@ -291,6 +292,7 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
 
         impl<A: #stack::od::AppObjects> #stack::od::Dictionary for Od<A> {
             const PERSISTENT_SIZE: usize = 0 #(+ <#types as #stack::value::Persist>::SIZE)*;
+            const SDO_BLOCK_TRANSFER: bool = #block_transfer;
 
             #[allow(unused_mut, unused_variables)]
             fn save_area(&self, area: #stack::od::Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {

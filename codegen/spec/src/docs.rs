@@ -33,6 +33,7 @@ pub fn markdown(d: &Device) -> String {
     let _ = writeln!(out, "| Product code | 0x{:08X} |", id.product_code);
     let _ = writeln!(out, "| Revision | 0x{:08X} |", id.revision);
     let _ = writeln!(out, "| Device profile | CiA {} |", id.profile);
+    let _ = writeln!(out, "| SDO block transfer | {} |", if id.sdo_block_transfer { "yes" } else { "no (abort 0504 0001h)" });
     let _ = writeln!(out);
 
     hardware(&mut out, d);

@@ -31,6 +31,9 @@ pub struct Identity {
     pub revision: u32,
     pub profile: u16,
     pub description: String,
+    /// Whether the SDO server does block transfer (CiA 301 7.2.4.3.9..16). Without it a block
+    /// request is refused with abort 0504 0001h and the code is left out of the image.
+    pub sdo_block_transfer: bool,
     pub datasheet_title: String,
     pub datasheet_version: String,
     pub datasheet_file: String,

@@ -273,6 +273,7 @@ fn identity(cx: &mut Cx<'_>, d: &S<raw::Device>) -> Identity {
         revision: u32_of(cx, &v.revision, "revision"),
         profile: cx.int_in::<u16>(&v.profile, &none, "profile", 0, 0xFFFF).unwrap_or(0),
         description: v.description.clone().unwrap_or_default(),
+        sdo_block_transfer: v.sdo_block_transfer.unwrap_or(true),
         datasheet_title: v.datasheet.value.title.clone(),
         datasheet_version: v.datasheet.value.version.clone(),
         datasheet_file: v.datasheet.value.file.clone(),

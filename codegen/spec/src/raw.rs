@@ -85,6 +85,9 @@ pub struct Device {
     pub profile: Num,
     #[serde(default)]
     pub description: Option<String>,
+    /// Whether the SDO server does block transfer; `true` when absent.
+    #[serde(default)]
+    pub sdo_block_transfer: Option<bool>,
     pub datasheet: S<Datasheet>,
 }
 

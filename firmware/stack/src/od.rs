@@ -423,6 +423,9 @@ pub trait Dictionary: ObjectDictionary {
     /// Bytes of the persistent block (every `storage: persistent` entry, index order).
     const PERSISTENT_SIZE: usize;
 
+    /// Whether the SDO server does block transfer (the spec's `sdo_block_transfer`).
+    const SDO_BLOCK_TRANSFER: bool;
+
     /// Hands the image of every persistent entry of `area` to `sink` with its offset in the
     /// block, so the block is written without a buffer of its size; `false` if `sink` failed.
     fn save_area(&self, area: Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool;

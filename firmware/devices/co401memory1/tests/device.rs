@@ -330,3 +330,34 @@ fn a_block_lost_in_both_banks_is_refused_on_both_sides_never_returned() {
     // Other blocks are unaffected.
     assert_eq!(lost.upload(0x5004, 1), Ok(0));
 }
+
+#[test]
+fn block_transfer_is_refused_as_an_unknown_command_and_segmented_transfer_still_works() {
+    // MEM-38: the datasheet does not offer SDO block transfer.
+    let mut rig = Rig::new();
+    let abort = |index: u16, sub: u8| {
+        let [lo, hi] = index.to_le_bytes();
+        [0x80, lo, hi, sub, 0x01, 0x00, 0x04, 0x05]
+    };
+    // Block upload initiate of 1008h (blksize 127), block download initiate of 5000h.1.
+    assert_eq!(rig.sdo([0xA4, 0x08, 0x10, 0x00, 0x7F, 0x00, 0x00, 0x00]), abort(0x1008, 0));
+    assert_eq!(rig.sdo([0xC6, 0x00, 0x50, 0x01, 0x01, 0x00, 0x00, 0x00]), abort(0x5000, 1));
+    // The server is idle again: a segmented upload of the device name runs to its end.
+    let init = rig.sdo([0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0]);
+    assert_eq!(init[0], 0x41, "segmented upload initiate response: {init:02X?}");
+    let mut name = Vec::new();
+    let mut toggle = 0;
+    loop {
+        let seg = rig.sdo([0x60 | toggle, 0, 0, 0, 0, 0, 0, 0]);
+        assert_eq!(seg[0] & 0xF0, toggle, "segment response {seg:02X?}");
+        let unused = usize::from((seg[0] >> 1) & 7);
+        name.extend_from_slice(&seg[1..8 - unused]);
+        if seg[0] & 1 == 1 {
+            break;
+        }
+        toggle ^= 0x10;
+    }
+    assert_eq!(u32::from_le_bytes(init[4..8].try_into().unwrap()) as usize, name.len());
+    // Nothing was stored by the refused download.
+    assert_eq!(rig.upload(0x5000, 1), Ok(0));
+}

@@ -97,6 +97,8 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
 }
 
 impl<D: Dictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, P> {
+    const BLOCK_TRANSFER: bool = D::SDO_BLOCK_TRANSFER;
+
     fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
         self.od.read(index, sub, offset, buf, Side::Bus)
     }

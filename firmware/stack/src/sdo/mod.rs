@@ -69,6 +69,10 @@ use command::{BlockSegment, Mux, Request};
 
 /// What the SDO server reads and writes.
 pub trait SdoTarget {
+    /// Whether block transfers are served. If not, a block request is refused with
+    /// `UnknownCommand` and, the constant being false, the block code is not in the image.
+    const BLOCK_TRANSFER: bool = true;
+
     /// Reads the value of `index`/`sub` from byte `offset` into `buf`; `total` is the
     /// value's full length. Includes the read access check.
     fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
@@ -177,10 +181,11 @@ impl<const N: usize> SdoServer<N> {
 
     /// A received request (the payload of a CAN frame on COB-ID 600h + node ID). Returns the
     /// response payload if one is due: always 8 bytes, a valid SDO response or an abort.
-    pub fn on_request(&mut self, data: &[u8], now_us: u64, target: &mut impl SdoTarget) -> Option<[u8; 8]> {
+    pub fn on_request<T: SdoTarget>(&mut self, data: &[u8], now_us: u64, target: &mut T) -> Option<[u8; 8]> {
         let frame = command::pad(data);
         self.last_us = now_us;
-        if let State::BlockDownload(down) = &mut self.state
+        if T::BLOCK_TRANSFER
+            && let State::BlockDownload(down) = &mut self.state
             && down.receiving()
             && !command::is_abort(&frame)
         {
@@ -202,6 +207,9 @@ impl<const N: usize> SdoServer<N> {
                 let started = segmented::initiate_upload(mux, target);
                 self.start(mux, started)
             }
+            (Request::BlockDownloadInitiate { mux, .. } | Request::BlockUploadInitiate { mux, .. }, _) if !T::BLOCK_TRANSFER => {
+                self.abort(current.unwrap_or(mux), SdoAbort::UnknownCommand)
+            }
             (Request::BlockDownloadInitiate { mux, crc, size }, _) => {
                 let started = block::initiate_download(mux, crc, size, N, target);
                 self.start(mux, started)
@@ -218,19 +226,19 @@ impl<const N: usize> SdoServer<N> {
                 let (mux, step) = (up.mux, up.segment(toggle, target));
                 self.step(mux, step)
             }
-            (Request::BlockDownloadEnd { n, crc }, State::BlockDownload(down)) => {
+            (Request::BlockDownloadEnd { n, crc }, State::BlockDownload(down)) if T::BLOCK_TRANSFER => {
                 let (mux, step) = (down.mux, down.end(n, crc, &self.buf, target));
                 self.step(mux, step)
             }
-            (Request::BlockUploadStart, State::BlockUpload(up)) => {
+            (Request::BlockUploadStart, State::BlockUpload(up)) if T::BLOCK_TRANSFER => {
                 let (mux, step) = (up.mux, up.start());
                 self.step(mux, step)
             }
-            (Request::BlockUploadAck { ackseq, blksize }, State::BlockUpload(up)) => {
+            (Request::BlockUploadAck { ackseq, blksize }, State::BlockUpload(up)) if T::BLOCK_TRANSFER => {
                 let (mux, step) = (up.mux, up.ack(ackseq, blksize));
                 self.step(mux, step)
             }
-            (Request::BlockUploadEnd, State::BlockUpload(up)) => {
+            (Request::BlockUploadEnd, State::BlockUpload(up)) if T::BLOCK_TRANSFER => {
                 let (mux, step) = (up.mux, up.end());
                 self.step(mux, step)
             }
@@ -242,9 +250,11 @@ impl<const N: usize> SdoServer<N> {
 
     /// Called every poll: the next frame the server sends on its own (a block upload
     /// segment, one per call; the `Timeout` abort of a transfer the client left waiting).
-    pub fn poll(&mut self, now_us: u64, target: &mut impl SdoTarget) -> Option<[u8; 8]> {
+    pub fn poll<T: SdoTarget>(&mut self, now_us: u64, target: &mut T) -> Option<[u8; 8]> {
         let mux = self.state.mux()?;
-        if let State::BlockUpload(up) = &mut self.state {
+        if T::BLOCK_TRANSFER
+            && let State::BlockUpload(up) = &mut self.state
+        {
             match up.next_segment(target) {
                 Ok(Some(frame)) => {
                     self.last_us = now_us;
