@@ -1,0 +1,199 @@
+//! CO401Memory1 on the STM32F042K6 board: CAN on bxCAN at the BD pins' bit rate, the serial
+//! host protocol on USART2 at the RSBD pins' baud rate, the two banks in two 24C128 EEPROMs.
+//! Pin map: the `coforge_board_stm32f0` crate documentation and `PINS.md`.
+//!
+//! `cargo build --release` here, then `cargo xtask flash --device co401memory1 --board stm32f0
+//! --chip STM32F042K6Tx` (or `probe-rs run --chip STM32F042K6Tx <elf>`).
+#![no_std]
+#![no_main]
+#![deny(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used)]
+
+use co401memory1::Memory1;
+use coforge_board_stm32f0::board::{ConfigChain, StatusPins, Stm32Board};
+use coforge_board_stm32f0::{can, clock, i2c::I2cBus};
+use coforge_stack::node::BusState;
+use core::cell::RefCell;
+use core::mem::MaybeUninit;
+use cortex_m_rt::entry;
+use eeprom24x::{Eeprom24x, SlaveAddr, Storage};
+use embedded_hal_02::digital::v2::OutputPin;
+use embedded_hal_02::serial::{Read, Write};
+use embedded_hal_bus::i2c::RefCellDevice;
+use panic_halt as _;
+use stm32f0xx_hal::can::CanInstance;
+use stm32f0xx_hal::can::bxcan::{self, filter::Mask32};
+use stm32f0xx_hal::gpio::gpioa::{PA2, PA3, PA11, PA12};
+use stm32f0xx_hal::gpio::gpiob::{PB0, PB1};
+use stm32f0xx_hal::gpio::{AF1, AF4, Alternate, Output, PushPull};
+use stm32f0xx_hal::i2c::I2c;
+use stm32f0xx_hal::pac;
+use stm32f0xx_hal::prelude::*;
+use stm32f0xx_hal::serial::Serial;
+
+/// One bank: a 24C128 (16 KiB, 64-byte pages, two address bytes) on the shared bus.
+type Bank = Storage<RefCellDevice<'static, I2cBus>, eeprom24x::page_size::B64, eeprom24x::addr_size::TwoBytes, eeprom24x::unique_serial::No, clock::MsDelay>;
+type Device = Memory1<Bank, Stm32Board>;
+type Host = Serial<pac::USART2, PA2<Alternate<AF1>>, PA3<Alternate<AF1>>>;
+type Can = bxcan::Can<CanInstance<PA12<Alternate<AF4>>, PA11<Alternate<AF4>>>>;
+/// CANLEDR#, CANLEDE#.
+type Leds = (PB0<Output<PushPull>>, PB1<Output<PushPull>>);
+/// Answers of the serial host protocol are at most this long.
+const ANSWER: usize = 16;
+
+#[entry]
+fn main() -> ! {
+    // cortex-m-rt turns these into `&'static mut` (no unsafe): the bus and the module live in
+    // .bss, so nothing large is built on the 6 KiB stack. `MaybeUninit` rather than `Option`:
+    // `None` of the module is not all zeros, which would put its 1.9 KiB in .data, i.e. also
+    // in flash; `MaybeUninit::write` is safe and hands out the `&'static mut`.
+    static mut BUS: MaybeUninit<RefCell<I2cBus>> = MaybeUninit::uninit();
+    static mut DEVICE: MaybeUninit<Device> = MaybeUninit::uninit();
+    let (Some(core), Some(mut p)) = (cortex_m::Peripherals::take(), pac::Peripherals::take()) else { panic!("peripherals taken twice") };
+
+    #[cfg(not(feature = "hsi48"))]
+    let cfgr = p.RCC.configure().hse(8.mhz(), stm32f0xx_hal::rcc::HSEBypassMode::NotBypassed);
+    #[cfg(feature = "hsi48")]
+    let cfgr = p.RCC.configure().hsi48();
+    let mut rcc = cfgr.sysclk(48.mhz()).pclk(48.mhz()).freeze(&mut p.FLASH);
+    clock::start(core.SYST);
+
+    let gpioa = p.GPIOA.split(&mut rcc);
+    let gpiob = p.GPIOB.split(&mut rcc);
+    let (can_pins, host_pins, i2c_pins, supply_pin, status, mut leds, mut chain) = cortex_m::interrupt::free(|cs| {
+        (
+            (gpioa.pa12.into_alternate_af4(cs), gpioa.pa11.into_alternate_af4(cs)),
+            (gpioa.pa2.into_alternate_af1(cs), gpioa.pa3.into_alternate_af1(cs)),
+            (gpiob.pb6.into_alternate_af1(cs).set_open_drain(cs), gpiob.pb7.into_alternate_af1(cs).set_open_drain(cs)),
+            gpioa.pa0.into_analog(cs),
+            StatusPins {
+                mem1_error: gpioa.pa4.into_push_pull_output(cs),
+                mem2_error: gpioa.pa5.into_push_pull_output(cs),
+                new_can_data: gpioa.pa6.into_push_pull_output(cs),
+                voltage_low: gpioa.pa7.into_push_pull_output(cs),
+            },
+            (gpiob.pb0.into_push_pull_output(cs), gpiob.pb1.into_push_pull_output(cs)),
+            ConfigChain { clk: gpiob.pb3.into_push_pull_output(cs), load: gpiob.pb4.into_push_pull_output(cs), data: gpiob.pb5.into_pull_up_input(cs) },
+        )
+    });
+    let _ = leds.0.set_high();
+    let _ = leds.1.set_high();
+
+    // The HAL enables and resets I2C1; its timing is replaced (see `i2c`).
+    let (i2c1, _pins) = I2c::i2c1(p.I2C1, i2c_pins, 400.khz(), &mut rcc).release();
+    let bus: &'static RefCell<I2cBus> = BUS.write(RefCell::new(I2cBus::new(i2c1)));
+    let bank = |a0| Storage::new(Eeprom24x::new_24x128(RefCellDevice::new(bus), SlaveAddr::Alternative(false, false, a0)), clock::MsDelay);
+    let board = Stm32Board::new(chain.read(), stm32f0xx_hal::adc::Adc::new(p.ADC, &mut rcc), supply_pin, status);
+    let Some(device) = mount(DEVICE, [bank(false), bank(true)], board) else {
+        // Reserved configuration pins: the module does not start. The error LED says so.
+        let _ = leds.1.set_low();
+        loop {
+            cortex_m::asm::wfi();
+        }
+    };
+    let config = device.config();
+
+    let host = Serial::usart2(p.USART2, host_pins, config.serial_baud.bps(), &mut rcc);
+    let mut bxcan = bxcan::Can::builder(CanInstance::new(p.CAN, can_pins.0, can_pins.1, &mut rcc))
+        .set_bit_timing(can::bit_timing(config.can_bitrate_kbit))
+        .leave_disabled();
+    bxcan.modify_filters().enable_bank(0, Mask32::accept_all());
+    // Joins the bus once it sees 11 recessive bits, in the background: a bus held dominant at
+    // power-on must not stop the serial host. ABOM (set here) restarts after bus-off by itself.
+    let _ = bxcan.enable_non_blocking();
+
+    run(device, host, bxcan, leds)
+}
+
+/// The main loop. Not inlined either: the device's handlers inlined here have frames of their
+/// own, which must not add to `mount`'s (see there).
+#[inline(never)]
+fn run(device: &'static mut Device, mut host: Host, mut bxcan: Can, mut leds: Leds) -> ! {
+    device.start(0);
+    let mut answer = [0_u8; ANSWER];
+    // A frame the mailboxes did not take (all three busy with frames of higher or equal
+    // priority, or one bxcan took out to make room): sent before anything new is polled.
+    let mut held: Option<bxcan::Frame> = None;
+    let mut bus_state = BusState::Active;
+    let (mut last_ms, mut now_ms) = (clock::millis(), 0_u64);
+    loop {
+        let ms = clock::millis();
+        // A 64-bit time that does not wrap after 49 days as the 32-bit counter does.
+        now_ms += u64::from(ms.wrapping_sub(last_ms));
+        last_ms = ms;
+        let now_us = now_ms * 1000;
+
+        loop {
+            match host.read() {
+                Ok(byte) => {
+                    let n = device.on_serial_byte(byte, ms, &mut answer);
+                    for &b in answer.get(..n).unwrap_or(&[]) {
+                        let _ = nb::block!(host.write(b));
+                    }
+                }
+                // Framing, noise, overrun: the flag is cleared, the byte (if any) comes next.
+                Err(nb::Error::Other(_)) => {}
+                Err(nb::Error::WouldBlock) => break,
+            }
+        }
+
+        loop {
+            match bxcan.receive() {
+                Ok(frame) => {
+                    if let Some(frame) = can::from_bxcan(&frame) {
+                        device.on_frame(&frame, now_us);
+                    }
+                }
+                // A FIFO overrun: frames were lost, the rest are still there.
+                Err(nb::Error::Other(())) => {}
+                Err(nb::Error::WouldBlock) => break,
+            }
+        }
+
+        let state = can::bus_state(esr(&mut bxcan));
+        if state != bus_state {
+            bus_state = state;
+            device.on_bus_state(state, now_us);
+        }
+
+        if let Some(frame) = held.take() {
+            held = transmit(&mut bxcan, frame);
+        }
+        while held.is_none() {
+            let Some(frame) = device.poll(now_us) else { break };
+            held = can::to_bxcan(&frame).and_then(|f| transmit(&mut bxcan, f));
+        }
+
+        // The 32-bit milliseconds: a u64 here would link a 64-bit division (about 1 KiB) for
+        // the patterns' periods; the wrap after 49 days only shifts a flash phase once.
+        let indicators = device.node().leds();
+        let _ = leds.0.set_state((!indicators.run.level(u64::from(ms))).into());
+        let _ = leds.1.set_state((!indicators.error.level(u64::from(ms))).into());
+    }
+}
+
+/// Builds the module (reading the configuration, mounting the banks) into `slot`. Not inlined:
+/// the module's construction moves some kilobytes of temporaries, and in `main` they would keep
+/// that much of the 6 KiB stack for ever; here they are gone when it returns.
+#[inline(never)]
+fn mount(slot: &'static mut MaybeUninit<Device>, banks: [Bank; 2], board: Stm32Board) -> Option<&'static mut Device> {
+    match Memory1::new(banks, board) {
+        Ok(device) => Some(slot.write(device)),
+        Err(_) => None,
+    }
+}
+
+/// Queues `frame`; returns what could not be queued: `frame` itself, or the lower-priority
+/// frame bxcan aborted to make room for it.
+fn transmit<I: bxcan::Instance>(can: &mut bxcan::Can<I>, frame: bxcan::Frame) -> Option<bxcan::Frame> {
+    match can.transmit(&frame) {
+        Ok(status) => status.dequeued_frame().cloned(),
+        Err(_) => Some(frame),
+    }
+}
+
+/// CAN_ESR: the controller's error state (bxcan 0.6 has no accessor for it).
+fn esr(can: &mut Can) -> u32 {
+    // SAFETY: a read of a read-only status register, without side effects; bxcan owns the
+    // peripheral but never writes ESR's read-only bits, and nothing else runs concurrently.
+    unsafe { can.instance().peripheral() }.esr.read().bits()
+}

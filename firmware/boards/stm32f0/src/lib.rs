@@ -1,0 +1,44 @@
+//! The STM32F042K6 board (Cortex-M0, 48 MHz, 32 KiB flash, 6 KiB RAM, LQFP32/UFQFPN32) for
+//! CO401Memory1: bxCAN, the serial host on USART2, the two memory banks in two 24C128 EEPROMs
+//! on I2C1, the 16 configuration pins through two 74HC165 shift registers, the supply on the
+//! ADC, the status outputs and the CANopen LEDs on GPIOs.
+//!
+//! The chip has 25 I/O pins (23 without SWD); the datasheet's 16 configuration pins, CAN, the
+//! host UART, the EEPROM bus, the supply input, four status outputs and two LEDs would need 30.
+//! The configuration pins therefore go through a 16-bit 74HC165 chain on three pins, read
+//! once at power-on (the module reads them only then).
+//!
+//! | Signal (datasheet) | STM32F042K6 pin (LQFP32 no.) | Use |
+//! |---|---|---|
+//! | CRX / CTX (TTL, to the transceiver) | PA11 (21) / PA12 (22) | CAN_RX / CAN_TX, AF4 |
+//! | RSRX / RSTX (through an RS232 transceiver) | PA3 (9) / PA2 (8) | USART2_RX / USART2_TX, AF1 |
+//! | EEPROM bus SCL / SDA | PB6 (29) / PB7 (30) | I2C1, AF1, open drain, 4.7 kOhm pull-ups to 3.3 V |
+//! | bank 1 / bank 2 | - | 24C128 at A2..A0 = 000 (0x50) / 001 (0x51) |
+//! | supply (behind the input diodes) | PA0 (6) | ADC_IN0, 110 kOhm / 10 kOhm divider (1/12, 39.6 V full scale) |
+//! | MEM1ERR# | PA4 (10) | push-pull output, active low |
+//! | MEM2ERR# | PA5 (11) | push-pull output, active low |
+//! | STATE4# (new CAN monitoring data) | PA6 (12) | push-pull output, active low |
+//! | STATE7# (voltage low) | PA7 (13) | push-pull output, active low |
+//! | CANLEDR# (green) | PB0 (14) | push-pull output, active low, CiA 303-3 run LED |
+//! | CANLEDE# (red) | PB1 (15) | push-pull output, active low, CiA 303-3 error LED |
+//! | 74HC165 CLK | PB3 (26) | push-pull output |
+//! | 74HC165 SH/LD# | PB4 (27) | push-pull output |
+//! | 74HC165 QH (U1) | PB5 (28) | input with pull-up |
+//! | ID0..ID6, CFG2 | U1 inputs A..H | 10 kOhm pull-ups, switches to ground |
+//! | BD0..BD2, RSBD0..RSBD2, CFG0, CFG1 | U2 inputs A..H (U2 QH to U1 SER) | 10 kOhm pull-ups, switches to ground |
+//! | 8 MHz crystal | PF0 (2) / PF1 (3) | HSE, PLL x6 = 48 MHz (feature `hsi48`: none) |
+//! | SWDIO / SWCLK | PA13 (23) / PA14 (24) | debug, flashing |
+//! | FU# | BOOT0 (31) | high = ROM bootloader; not read by the firmware |
+//! | RES# | NRST (4) | reset |
+//! | spare | PA1, PA8, PA9, PA10, PA15 | reserved STATE2#, STATE3#, STATE5#, STATE6# are not driven |
+//!
+//! The datasheet's inversions (ID, BD, RSBD and CFG active low) are applied by the device
+//! crate's decoders: [`board::ConfigWord`] hands over raw levels.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
+
+pub mod board;
+pub mod can;
+pub mod clock;
+pub mod i2c;
