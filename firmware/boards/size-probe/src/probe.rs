@@ -13,11 +13,11 @@ macro_rules! probe {
 
         #[cortex_m_rt::entry]
         fn main() -> ! {
-            // cortex-m-rt turns this into a `&'static mut` (no unsafe here): the node lives
-            // in .bss, so the size report shows its static RAM.
-            static mut NODE: Option<$device::Node<NoAppObjects, NoStore>> = None;
             let od = $device::Od::new(black_box($device::Mode::ALL[0]), black_box($node_id), NoAppObjects);
-            let node = NODE.insert(coforge_stack::node::Node::new(od, NoStore, $device::node_config($node_id)));
+            let node = coforge_stack::node::Node::new(od, NoStore, $device::node_config($node_id));
+            // The node lives in .bss (a `MaybeUninit` static), so the size report shows its
+            // static RAM and no copy of it in flash.
+            let Some(node) = cortex_m::singleton!(: $device::Node<NoAppObjects, NoStore> = node) else { loop {} };
             node.start(0);
             let mut now = 0_u64;
             #[allow(unused_mut, unused_variables)]

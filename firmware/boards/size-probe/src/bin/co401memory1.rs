@@ -55,11 +55,9 @@ impl Board for ProbeBoard {
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    // cortex-m-rt turns this into a `&'static mut` (no unsafe here): the module lives in
-    // .bss, so the size report shows its static RAM.
-    static mut DEVICE: Option<Memory1<ProbeEeprom, ProbeBoard>> = None;
     let Ok(device) = Memory1::new([ProbeEeprom, ProbeEeprom], ProbeBoard) else { loop {} };
-    let device = DEVICE.insert(device);
+    // The module lives in .bss, so the size report shows its static RAM.
+    let Some(device) = cortex_m::singleton!(: Memory1<ProbeEeprom, ProbeBoard> = device) else { loop {} };
     device.start(0);
     let mut now = 0_u64;
     let mut answer = [0_u8; 16];
