@@ -25,18 +25,19 @@ type Device = Memory1<BorrowedEeprom<'static>, FixedBoard>;
 
 #[entry]
 fn main() -> ! {
-    // cortex-m-rt turns these into `&'static mut` (no unsafe): the banks and the module live
-    // in .bss, and the module only borrows the banks, so nothing large is built on the stack.
+    // cortex-m-rt turns these into `&'static mut` (no unsafe): the banks live in .bss, and the
+    // module only borrows them, so nothing large is built on the stack.
     static mut BANK1: [u8; BANK_SIZE] = [0; BANK_SIZE];
     static mut BANK2: [u8; BANK_SIZE] = [0; BANK_SIZE];
-    static mut DEVICE: Option<Device> = None;
     let Some(core) = cortex_m::Peripherals::take() else { panic!("peripherals taken twice") };
     clock::start(core.SYST);
     let (host, can) = (Uart::new(UART0), Uart::new(UART1));
     let Ok(device) = Memory1::new([BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)], FixedBoard::new(5)) else {
         panic!("reserved configuration pins")
     };
-    let device = DEVICE.insert(device);
+    // In a `MaybeUninit` static (.bss): an `Option` static would sit in .data, a second copy
+    // of the module in flash.
+    let Some(device) = cortex_m::singleton!(: Device = device) else { panic!("started twice") };
     device.start(0);
     let mut lines = slcan::Decoder::new();
     let mut answer = [0_u8; 16];
