@@ -4,6 +4,7 @@
 //! Both say what they install before they install it.
 #![forbid(unsafe_code)]
 
+mod bench;
 mod images;
 mod setup;
 mod size;
@@ -18,6 +19,7 @@ fn main() -> ExitCode {
         Some("test") => test(),
         Some("size") => setup::rust_targets().and_then(|()| size::report()),
         Some("flash") => images::flash(args.get(1..).unwrap_or_default()),
+        Some("bench") => bench::main(args.get(1..).unwrap_or_default()),
         _ => {
             eprintln!(
                 "usage: cargo xtask <dist|test|size|flash>\n  dist   check every spec; write EDS files, docs and firmware images into target/dist/\n  test   install missing tools, then run the whole test suite\n  size   flash and RAM of each device's generated code on a Cortex-M0\n  flash  --device <d> --board <b> [--chip <c>]: write an image with probe-rs"
