@@ -9,12 +9,12 @@ use coforge_stack::od::{AccessContext, AppObjects, EntryInfo, NmtState, ObjectDi
 struct Memory(std::collections::BTreeMap<(u16, u8), Vec<u8>>);
 
 impl AppObjects for Memory {
-    fn read(&mut self, e: &EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
-        let v = self.0.get(&(e.index, sub)).cloned().unwrap_or_else(|| vec![0; usize::from(e.size.min(8))]);
+    fn read(&mut self, e: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        let v = self.0.get(&(index, sub)).cloned().unwrap_or_else(|| vec![0; usize::from(e.size.min(8))]);
         read_slice(&v, offset, buf)
     }
-    fn write(&mut self, e: &EntryInfo, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
-        self.0.insert((e.index, sub), data.to_vec());
+    fn write(&mut self, _: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        self.0.insert((index, sub), data.to_vec());
         Ok(())
     }
 }
@@ -35,16 +35,18 @@ fn read(od: &mut impl ObjectDictionary, index: u16, sub: u8, side: Side) -> Resu
 fn sweep(od: &mut impl ObjectDictionary, table: &[EntryInfo]) -> usize {
     let mut n = 0;
     for run in table {
-        for sub in run.sub..=run.last_sub {
-            let value = read(od, run.index, sub, Side::Device).unwrap_or_else(|a| panic!("{:04X}.{sub}: {a:?}", run.index));
-            assert!(value.len() <= usize::from(run.size), "{:04X}.{sub}", run.index);
-            // Fixed-size values are written back whole; a value outside its own limits (a
-            // default of 0 under `low: 1`) is refused with the range abort, nothing else.
-            match od.write(run.index, sub, &value, Side::Device, &PREOP) {
-                Ok(()) | Err(SdoAbort::ValueTooLow | SdoAbort::ValueTooHigh | SdoAbort::InvalidValue) => {}
-                Err(a) => panic!("{:04X}.{sub} write-back: {a:?}", run.index),
+        for index in run.index..=run.index + u16::from(run.copies) {
+            for sub in run.sub..=run.last_sub {
+                let value = read(od, index, sub, Side::Device).unwrap_or_else(|a| panic!("{index:04X}.{sub}: {a:?}"));
+                assert!(value.len() <= usize::from(run.size), "{index:04X}.{sub}");
+                // Fixed-size values are written back whole; a value outside its own limits (a
+                // default of 0 under `low: 1`) is refused with the range abort, nothing else.
+                match od.write(index, sub, &value, Side::Device, &PREOP) {
+                    Ok(()) | Err(SdoAbort::ValueTooLow | SdoAbort::ValueTooHigh | SdoAbort::InvalidValue) => {}
+                    Err(a) => panic!("{index:04X}.{sub} write-back: {a:?}"),
+                }
+                n += 1;
             }
-            n += 1;
         }
     }
     n

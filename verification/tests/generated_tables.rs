@@ -34,7 +34,8 @@ fn check(d: &Device, mode: Option<&str>, table: &[EntryInfo], rpdos: &[PdoDefaul
             covered += 1;
         }
     }
-    let in_table: usize = table.iter().map(|r| usize::from(r.last_sub - r.sub) + 1).sum();
+    assert!(table.iter().all(|r| r.copies <= coforge_stack::pdo::mapping::MAX_COPIES), "{ctx}: copies fit the PDO mapping cache");
+    let in_table: usize = table.iter().map(|r| (usize::from(r.last_sub - r.sub) + 1) * (usize::from(r.copies) + 1)).sum();
     assert_eq!(in_table, covered, "{ctx}: the table holds exactly the spec's entries");
     for (dir, generated) in [(PdoDir::Rx, rpdos), (PdoDir::Tx, tpdos)] {
         let want: Vec<_> = d.pdo.pdos.iter().filter(|p| p.dir == dir && in_mode(&p.modes, mode)).collect();

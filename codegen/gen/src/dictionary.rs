@@ -247,14 +247,7 @@ fn reset_groups(resets: &[Place]) -> Vec<TokenStream> {
 pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
     let stack = &options.stack;
     let block_transfer = d.identity.sdo_block_transfer;
-    let mut parts = Parts {
-        structs: Vec::new(),
-        fields: Vec::new(),
-        names: Vec::new(),
-        field_arms: Vec::new(),
-        persist: Vec::new(),
-        resets: Vec::new(),
-    };
+    let mut parts = Parts { structs: Vec::new(), fields: Vec::new(), names: Vec::new(), field_arms: Vec::new(), persist: Vec::new(), resets: Vec::new() };
     for slot in slots(d) {
         slot_parts(&slot, stack, &mut parts);
     }

@@ -10,13 +10,26 @@ use quote::{format_ident, quote};
 /// Value limits of an entry: (low, high, allowed values).
 type LimitsKey = (Option<i64>, Option<i64>, Vec<i64>);
 
-/// One `EntryInfo`: an entry, or a run of consecutive sub-entries that describe alike.
+/// The most copies one run describes: what a PDO mapping cache entry has room for
+/// (`coforge_stack::pdo::mapping::MAX_COPIES`); longer series of alike objects take more runs.
+const MAX_COPIES: u8 = 31;
+
+/// One `EntryInfo`: an entry, or a run of consecutive sub-entries that describe alike, in
+/// `copies + 1` consecutive objects.
 #[derive(Debug, Clone, PartialEq)]
 struct Run {
     index: u16,
     sub: u8,
     last_sub: u8,
+    copies: u8,
     meta: Meta,
+}
+
+impl Run {
+    /// Describes the same sub-entries as `other`, whatever the object.
+    fn alike(&self, other: &Run) -> bool {
+        (self.sub, self.last_sub, &self.meta) == (other.sub, other.last_sub, &other.meta)
+    }
 }
 
 /// Everything but the sub-index; equal metadata on consecutive subs forms a run.
@@ -62,18 +75,40 @@ fn meta(e: &Entry) -> Meta {
     }
 }
 
-/// The runs of one mode, sorted by (index, sub).
+/// The runs of one object in one mode, sorted by sub.
+fn object_runs(o: &Object, mode: Option<&str>) -> Vec<Run> {
+    let mut entries: Vec<&Entry> = o.entries.iter().filter(|e| in_mode(&e.modes, mode)).collect();
+    entries.sort_by_key(|e| e.sub);
+    let mut out: Vec<Run> = Vec::new();
+    for e in entries {
+        let m = meta(e);
+        match out.last_mut() {
+            Some(last) if u16::from(last.last_sub) + 1 == u16::from(e.sub) && last.meta == m => last.last_sub = e.sub,
+            _ => out.push(Run { index: o.index, sub: e.sub, last_sub: e.sub, copies: 0, meta: m }),
+        }
+    }
+    out
+}
+
+/// The runs of one mode, sorted by (index, sub). An app-backed object described exactly like
+/// the object at the index before it is not listed again: the earlier object's runs count it
+/// as a copy (the field dispatch never sees copies, app objects get the index accessed).
 fn runs(d: &Device, mode: Option<&str>) -> Vec<Run> {
     let mut out: Vec<Run> = Vec::new();
+    // Where the runs of the last object listed start.
+    let mut last_object = 0;
     for o in d.objects.iter().filter(|o: &&Object| in_mode(&o.modes, mode)) {
-        let mut entries: Vec<&Entry> = o.entries.iter().filter(|e| in_mode(&e.modes, mode)).collect();
-        entries.sort_by_key(|e| e.sub);
-        for e in entries {
-            let m = meta(e);
-            match out.last_mut() {
-                Some(last) if last.index == o.index && u16::from(last.last_sub) + 1 == u16::from(e.sub) && last.meta == m => last.last_sub = e.sub,
-                _ => out.push(Run { index: o.index, sub: e.sub, last_sub: e.sub, meta: m }),
-            }
+        let runs = object_runs(o, mode);
+        let previous = out.get_mut(last_object..).unwrap_or_default();
+        let repeats = previous.first().is_some_and(|p| u32::from(p.index) + u32::from(p.copies) + 1 == u32::from(o.index) && p.copies < MAX_COPIES)
+            && runs.iter().all(|r| r.meta.storage == "App")
+            && previous.len() == runs.len()
+            && previous.iter().zip(&runs).all(|(p, r)| p.alike(r));
+        if repeats {
+            previous.iter_mut().for_each(|p| p.copies += 1);
+        } else {
+            last_object = out.len();
+            out.extend(runs);
         }
     }
     out
@@ -84,7 +119,8 @@ fn ident(name: &str) -> Ident {
 }
 
 fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<LimitsKey>) -> TokenStream {
-    let Run { index, sub, last_sub, meta: m } = r;
+    let Run { index, sub, last_sub, copies, meta: m } = r;
+    let copies = crate::dec((*copies).into());
     let object = crate::dec(object.into());
     let index = crate::hex((*index).into(), 4);
     let (sub, last_sub) = (crate::dec((*sub).into()), crate::dec((*last_sub).into()));
@@ -117,6 +153,7 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
             object: #object,
             sub: #sub,
             last_sub: #last_sub,
+            copies: #copies,
             data_type: #stack::od::DataType::#data_type,
             access: #stack::od::Access::#access,
             host_access: #stack::od::HostAccess::#host_access,
@@ -189,11 +226,15 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../spec/co401memory1.yaml");
         let d = coforge_spec::load_file(&path).into_device().expect("spec loads");
         let runs = runs(&d, None);
-        let block: Vec<&Run> = runs.iter().filter(|r| r.index == 0x5000).collect();
-        assert_eq!(block.iter().map(|r| (r.sub, r.last_sub)).collect::<Vec<_>>(), [(0, 0), (1, 128)]);
+        // The 64 blocks 5000..503F are alike: two objects listed, 31 and 32 copies.
+        let blocks: Vec<(u16, u8, u8, u8)> =
+            runs.iter().filter(|r| (0x5000..=0x503F).contains(&r.index)).map(|r| (r.index, r.sub, r.last_sub, r.copies)).collect();
+        assert_eq!(blocks, [(0x5000, 0, 0, 31), (0x5000, 1, 128, 31), (0x5020, 0, 0, 31), (0x5020, 1, 128, 31)]);
+        // Nothing else repeats: 5C00 follows the blocks but is not alike.
+        assert!(runs.iter().filter(|r| !(0x5000..=0x503F).contains(&r.index)).all(|r| r.copies == 0));
         // Sorted, and runs never overlap.
         assert!(runs.windows(2).all(|w| (w[0].index, w[0].last_sub) < (w[1].index, w[1].sub)));
         let entries: usize = d.objects.iter().map(|o| o.entries.len()).sum();
-        assert!(runs.len() * 20 < entries, "{} runs for {entries} entries", runs.len());
+        assert!(runs.len() * 90 < entries, "{} runs for {entries} entries", runs.len());
     }
 }

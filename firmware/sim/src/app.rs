@@ -11,9 +11,9 @@ pub struct RamApp {
 }
 
 impl AppObjects for RamApp {
-    fn read(&mut self, entry: &EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+    fn read(&mut self, entry: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
         let zeros;
-        let value = match self.values.get(&(entry.index, sub)) {
+        let value = match self.values.get(&(index, sub)) {
             Some(v) => v.as_slice(),
             None => {
                 // Variable-length entries start empty; fixed-size ones read as zero.
@@ -25,8 +25,8 @@ impl AppObjects for RamApp {
         read_slice(value, offset, buf)
     }
 
-    fn write(&mut self, entry: &EntryInfo, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
-        self.values.insert((entry.index, sub), data.to_vec());
+    fn write(&mut self, _: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        self.values.insert((index, sub), data.to_vec());
         Ok(())
     }
 }

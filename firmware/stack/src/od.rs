@@ -156,6 +156,11 @@ pub struct EntryInfo {
     pub sub: u8,
     /// Last sub-index this description covers (equal to `sub` for a single entry).
     pub last_sub: u8,
+    /// How many further objects, `index + 1 ..= index + copies`, this run also describes:
+    /// objects that repeat alike (CO401Memory1's 64 memory blocks) share their runs. Only
+    /// app-backed objects repeat, so the field dispatch never sees a copy. At most
+    /// [`MAX_COPIES`](crate::pdo::mapping::MAX_COPIES).
+    pub copies: u8,
     pub data_type: DataType,
     /// CAN-side access.
     pub access: Access,
@@ -240,6 +245,11 @@ impl EntryInfo {
         (self.sub..=self.last_sub).contains(&sub)
     }
 
+    /// Whether this run describes object `index` (its own, or one of its copies).
+    pub fn covers_index(&self, index: u16) -> bool {
+        index >= self.index && index - self.index <= u16::from(self.copies)
+    }
+
     fn check_length(&self, len: usize) -> Result<(), SdoAbort> {
         let size = usize::from(self.size);
         let variable = matches!(self.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
@@ -306,21 +316,25 @@ pub fn read_slice(value: &[u8], offset: usize, buf: &mut [u8]) -> Result<ReadLen
 }
 
 /// Finds the description of `index`/`sub` in a table sorted by `(index, sub)` whose runs do
-/// not overlap: `NoObject` if the index is absent, `NoSubIndex` if only the sub-index is.
+/// not overlap (the runs of repeated objects are listed once, under the first index):
+/// `NoObject` if the index is absent, `NoSubIndex` if only the sub-index is.
 pub fn find(entries: &[EntryInfo], index: u16, sub: u8) -> Result<&EntryInfo, SdoAbort> {
     find_run(entries, index, sub).and_then(|run| entries.get(run).ok_or(SdoAbort::NoObject))
 }
 
 /// Like [`find`], but the position of the run in the table (PDO mappings keep it).
 pub fn find_run(entries: &[EntryInfo], index: u16, sub: u8) -> Result<usize, SdoAbort> {
-    // The last run that starts at or before (index, sub).
-    let after = entries.partition_point(|e| (e.index, e.sub) <= (index, sub));
-    let candidate = after.checked_sub(1).and_then(|i| entries.get(i).map(|e| (i, e)));
-    match candidate {
-        Some((i, e)) if e.index == index && e.covers(sub) => Ok(i),
-        Some((_, e)) if e.index == index => Err(SdoAbort::NoSubIndex),
-        _ if entries.get(after).is_some_and(|e| e.index == index) => Err(SdoAbort::NoSubIndex),
-        _ => Err(SdoAbort::NoObject),
+    // The object: the last run listed at or before `index` must describe it.
+    let listed = entries.partition_point(|e| e.index <= index);
+    let first = match listed.checked_sub(1).and_then(|i| entries.get(i)) {
+        Some(e) if e.covers_index(index) => e.index,
+        _ => return Err(SdoAbort::NoObject),
+    };
+    // The sub-index: the last of the object's runs that starts at or before it.
+    let after = entries.partition_point(|e| (e.index, e.sub) <= (first, sub));
+    match after.checked_sub(1).and_then(|i| entries.get(i).map(|e| (i, e))) {
+        Some((i, e)) if e.index == first && e.covers(sub) => Ok(i),
+        _ => Err(SdoAbort::NoSubIndex),
     }
 }
 
@@ -343,21 +357,21 @@ pub trait ObjectDictionary {
     /// The device's app-backed objects.
     fn app(&mut self) -> &mut Self::App;
 
-    /// Reads the value of the entry `info` describes, at `sub`, from byte `offset` into
+    /// Reads the value of `index`/`sub`, which `info` describes, from byte `offset` into
     /// `buf`: no lookup and no access check (the caller made both).
-    fn read_entry(&mut self, info: &EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+    fn read_entry(&mut self, info: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
         if info.storage == Storage::App {
-            return self.app().read(info, sub, offset, buf);
+            return self.app().read(info, index, sub, offset, buf);
         }
         self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.read(info, offset, buf)
     }
 
     /// Writes `data` (the whole value, little-endian) after its length and value checks; no
     /// lookup and no access check. A refused write leaves the stored value unchanged.
-    fn write_entry(&mut self, info: &EntryInfo, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+    fn write_entry(&mut self, info: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
         info.check_data(data)?;
         if info.storage == Storage::App {
-            return self.app().write(info, sub, data);
+            return self.app().write(info, index, sub, data);
         }
         self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.write(info, data)
     }
@@ -371,14 +385,14 @@ pub trait ObjectDictionary {
     fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8], side: Side) -> Result<ReadLen, SdoAbort> {
         let info = self.entry(index, sub)?;
         info.check_read(side)?;
-        self.read_entry(info, sub, offset, buf)
+        self.read_entry(info, index, sub, offset, buf)
     }
 
     /// Writes `data` after the checks for `side`: access, state, length and value.
     fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side, ctx: &AccessContext) -> Result<(), SdoAbort> {
         let info = self.entry(index, sub)?;
         info.check_write_access(side, ctx)?;
-        self.write_entry(info, sub, data)
+        self.write_entry(info, index, sub, data)
     }
 }
 
@@ -444,10 +458,11 @@ pub trait Dictionary: ObjectDictionary {
 
 /// Objects whose data the device keeps outside the dictionary (EEPROM banks, a memory card):
 /// the generated dictionary routes their reads and writes here, after its access checks.
-/// `entry` may describe a run of sub-indices; `sub` is the one accessed.
+/// `entry` may describe a run of sub-indices and of repeated objects; `index`/`sub` is the one
+/// accessed.
 pub trait AppObjects {
-    fn read(&mut self, entry: &EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
-    fn write(&mut self, entry: &EntryInfo, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
+    fn read(&mut self, entry: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
+    fn write(&mut self, entry: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
 }
 
 /// For devices without app-backed objects: nothing is routed here.
@@ -455,10 +470,10 @@ pub trait AppObjects {
 pub struct NoAppObjects;
 
 impl AppObjects for NoAppObjects {
-    fn read(&mut self, _: &EntryInfo, _: u8, _: usize, _: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+    fn read(&mut self, _: &EntryInfo, _: u16, _: u8, _: usize, _: &mut [u8]) -> Result<ReadLen, SdoAbort> {
         Err(SdoAbort::NoObject)
     }
-    fn write(&mut self, _: &EntryInfo, _: u8, _: &[u8]) -> Result<(), SdoAbort> {
+    fn write(&mut self, _: &EntryInfo, _: u16, _: u8, _: &[u8]) -> Result<(), SdoAbort> {
         Err(SdoAbort::NoObject)
     }
 }
@@ -471,6 +486,7 @@ pub(crate) const fn test_entry(data_type: DataType, access: Access, host_access:
         object: 0,
         sub: 0,
         last_sub: 0,
+        copies: 0,
         data_type,
         access,
         host_access,
@@ -606,9 +622,31 @@ mod tests {
     }
 
     #[test]
+    fn repeated_objects_resolve_through_their_first_index() {
+        let at = |index, sub, last_sub, copies| EntryInfo { index, sub, last_sub, copies, ..info(DataType::Unsigned8, Access::Ro, HostAccess::Ro, 1) };
+        // 5000..5003 alike (sub 0 and 1..=128), then 5C00 with subs 0..=2.
+        let table = [at(0x1000, 0, 0, 0), at(0x5000, 0, 0, 3), at(0x5000, 1, 128, 3), at(0x5C00, 0, 2, 0)];
+        for index in 0x5000..=0x5003 {
+            assert_eq!(find_run(&table, index, 0), Ok(1), "{index:04X}.0");
+            assert_eq!(find_run(&table, index, 1), Ok(2), "{index:04X}.1");
+            assert_eq!(find_run(&table, index, 128), Ok(2), "{index:04X}.128");
+            assert_eq!(find_run(&table, index, 129), Err(SdoAbort::NoSubIndex), "{index:04X}.129");
+        }
+        assert_eq!(find_run(&table, 0x5004, 0), Err(SdoAbort::NoObject));
+        assert_eq!(find_run(&table, 0x4FFF, 0), Err(SdoAbort::NoObject));
+        assert_eq!(find_run(&table, 0x5C00, 2), Ok(3));
+        assert_eq!(find_run(&table, 0x5C00, 3), Err(SdoAbort::NoSubIndex));
+        assert_eq!(find_run(&table, 0x5BFF, 0), Err(SdoAbort::NoObject));
+        assert!(at(0x5000, 0, 0, 3).covers_index(0x5003) && !at(0x5000, 0, 0, 3).covers_index(0x5004));
+        assert!(!at(0xFFFF, 0, 0, 0).covers_index(0xFFFE));
+    }
+
+    #[test]
     fn entry_info_is_small_enough_for_flash_tables() {
-        // 8 KiB of CO401Memory1 memory blocks take 128 runs; each must stay a few words.
-        assert!(core::mem::size_of::<EntryInfo>() <= 24, "{}", core::mem::size_of::<EntryInfo>());
+        // Most of a dictionary's flash is this table: 16 bytes and the limits pointer per run
+        // (20 bytes on Cortex-M).
+        let most = 16 + core::mem::size_of::<Option<&Limits>>();
+        assert!(core::mem::size_of::<EntryInfo>() <= most, "{}", core::mem::size_of::<EntryInfo>());
     }
 
     #[test]

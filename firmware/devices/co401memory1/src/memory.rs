@@ -78,8 +78,8 @@ fn abort(e: Error) -> SdoAbort {
 }
 
 impl<S: Storage> AppObjects for MemoryApp<S> {
-    fn read(&mut self, entry: &EntryInfo, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
-        match entry.index {
+    fn read(&mut self, _: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        match index {
             0x5C00 => read_slice(&self.banks.checksum(Self::bank(sub)?).to_le_bytes(), offset, buf),
             0x6000 => read_slice(&[self.banks.status(Self::bank(sub)?).bits()], offset, buf),
             0x6200 => read_slice(&[self.commands.get(Self::bank(sub)?).copied().unwrap_or(0)], offset, buf),
@@ -94,8 +94,8 @@ impl<S: Storage> AppObjects for MemoryApp<S> {
         }
     }
 
-    fn write(&mut self, entry: &EntryInfo, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
-        match entry.index {
+    fn write(&mut self, _: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        match index {
             0x6200 => {
                 let bank = Self::bank(sub)?;
                 let &[command] = data else { return Err(SdoAbort::LengthMismatch) };

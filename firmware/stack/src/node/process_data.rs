@@ -46,11 +46,11 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         let entries = self.od.entries();
         let mut at = 0;
         for m in r.mapping.entries() {
-            let end = at + usize::from(m.bytes);
+            let end = at + usize::from(m.bytes());
             if let (Some(src), Some(info)) = (data.get(at..end), m.info(entries))
-                && self.od.write_entry(info, m.sub, src).is_ok()
+                && self.od.write_entry(info, m.index(info), m.sub, src).is_ok()
             {
-                self.after_write(info.index, m.sub);
+                self.after_write(m.index(info), m.sub);
             }
             at = end;
         }
@@ -121,7 +121,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             .iter()
             .filter(|t| t.comm.valid())
             .flat_map(|t| t.mapping.entries())
-            .filter_map(|m| m.info(entries).map(|i| Self::filter_bit(i.index, m.sub)))
+            .filter_map(|m| m.info(entries).map(|i| Self::filter_bit(m.index(i), m.sub)))
             .fold(0, |acc, bit| acc | bit);
     }
 }

@@ -18,7 +18,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
         self.check_communication(index, sub, data, side)?;
         entry.check_write_access(side, &ctx)?;
-        self.od.write_entry(entry, sub, data)?;
+        self.od.write_entry(entry, index, sub, data)?;
         self.after_write(index, sub);
         if self.cfg.auto_save && entry.storage == Storage::Persistent && side != Side::Device {
             self.store.save(&self.od, crate::od::Area::ALL).map_err(|_| SdoAbort::Hardware)?;

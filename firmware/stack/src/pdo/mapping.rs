@@ -14,13 +14,33 @@ pub struct Mapped {
     /// Position in [`ObjectDictionary::entries`], or [`DUMMY`].
     pub run: u16,
     pub sub: u8,
-    pub bytes: u8,
+    /// Bits 0..=2: bytes - 1; bits 3..=7: which copy of the run's object is mapped (see
+    /// [`EntryInfo::copies`]). Every PDO caches eight of these, so they stay four bytes.
+    shape: u8,
 }
+
+/// The most copies a run may describe: what [`Mapped`] has room for.
+pub const MAX_COPIES: u8 = 31;
 
 /// The `run` of a dummy entry (indices 0002h..0007h fill RPDO bytes nobody needs).
 pub const DUMMY: u16 = u16::MAX;
 
 impl Mapped {
+    /// `bytes` is 1..=8 and `copy` at most [`MAX_COPIES`]; larger values are cut.
+    const fn new(run: u16, copy: u8, sub: u8, bytes: u8) -> Mapped {
+        Mapped { run, sub, shape: (copy << 3) | (bytes.wrapping_sub(1) & 7) }
+    }
+
+    /// Bytes in the PDO.
+    pub const fn bytes(&self) -> u8 {
+        (self.shape & 7) + 1
+    }
+
+    /// The mapped object's index, given its run's description.
+    pub fn index(&self, info: &EntryInfo) -> u16 {
+        info.index.wrapping_add(u16::from(self.shape >> 3))
+    }
+
     /// Decodes `index << 16 | sub << 8 | bits`.
     pub const fn decode(word: u32) -> (u16, u8, u8) {
         ((word >> 16) as u16, (word >> 8) as u8, word as u8)
@@ -55,8 +75,11 @@ pub fn check_entry(od: &impl ObjectDictionary, word: u32, dir: Dir) -> Result<Ma
         return Err(SdoAbort::NotMappable);
     }
     let bytes = bits / 8;
+    if bytes > 8 {
+        return Err(SdoAbort::PdoTooLong);
+    }
     if let Some(size) = dummy_bytes(index) {
-        return if dir == Dir::Rx && size == bytes && sub == 0 { Ok(Mapped { run: DUMMY, sub, bytes }) } else { Err(SdoAbort::NotMappable) };
+        return if dir == Dir::Rx && size == bytes && sub == 0 { Ok(Mapped::new(DUMMY, 0, sub, bytes)) } else { Err(SdoAbort::NotMappable) };
     }
     let entries = od.entries();
     let run = find_run(entries, index, sub)?;
@@ -71,7 +94,9 @@ pub fn check_entry(od: &impl ObjectDictionary, word: u32, dir: Dir) -> Result<Ma
     let variable = matches!(e.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
     let fits = if variable { u16::from(bytes) <= e.size } else { u16::from(bytes) == e.size };
     let run = u16::try_from(run).map_err(|_| SdoAbort::NotMappable)?;
-    if fits { Ok(Mapped { run, sub, bytes }) } else { Err(SdoAbort::NotMappable) }
+    // `find_run` only returns a run that covers `index`, so the copy is at most `e.copies`.
+    let copy = u8::try_from(index - e.index).map_err(|_| SdoAbort::NotMappable)?;
+    if fits { Ok(Mapped::new(run, copy, sub, bytes)) } else { Err(SdoAbort::NotMappable) }
 }
 
 /// A PDO's mapping, checked and cached so that sending and receiving need no lookups of the
@@ -89,7 +114,7 @@ impl Mapping {
         let mut m = Mapping::default();
         for &w in words {
             let e = check_entry(od, w, dir)?;
-            let total = m.bytes.saturating_add(e.bytes);
+            let total = m.bytes.saturating_add(e.bytes());
             if total > 8 {
                 return Err(SdoAbort::PdoTooLong);
             }
@@ -115,7 +140,7 @@ impl Mapping {
     }
 
     pub fn contains(&self, entries: &[EntryInfo], index: u16, sub: u8) -> bool {
-        self.entries().iter().any(|e| e.sub == sub && e.info(entries).is_some_and(|i| i.index == index))
+        self.entries().iter().any(|e| e.sub == sub && e.info(entries).is_some_and(|i| e.index(i) == index))
     }
 
     /// Reads the mapped values into a frame payload; returns its length.
@@ -123,10 +148,11 @@ impl Mapping {
         let entries = od.entries();
         let mut at = 0;
         for e in self.entries() {
-            let end = at + usize::from(e.bytes);
+            let end = at + usize::from(e.bytes());
             let dst = out.get_mut(at..end).ok_or(SdoAbort::PdoTooLong)?;
             dst.fill(0);
-            od.read_entry(e.info(entries).ok_or(SdoAbort::NoObject)?, e.sub, 0, dst)?;
+            let info = e.info(entries).ok_or(SdoAbort::NoObject)?;
+            od.read_entry(info, e.index(info), e.sub, 0, dst)?;
             at = end;
         }
         Ok(at)
