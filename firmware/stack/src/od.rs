@@ -299,10 +299,12 @@ pub fn decode_int(data_type: DataType, data: &[u8]) -> Option<i128> {
     if data.len() != bytes {
         return None;
     }
-    let raw = data.iter().rev().fold(0_u128, |acc, &b| acc << 8 | u128::from(b));
-    let value = raw as i128;
-    // Signed types: sign-extend from the type's width.
-    if lo < 0 && bits < 128 && raw >> (bits - 1) & 1 == 1 { Some(value - (1_i128 << bits)) } else { Some(value) }
+    // At most 64 bits: assembled in a u64, widened once (128-bit shifts are costly on a
+    // Cortex-M0).
+    let raw = data.iter().rev().fold(0_u64, |acc, &b| acc << 8 | u64::from(b));
+    // Signed types: sign-extend from the type's width by shifting its sign bit to bit 63.
+    let unused = 64 - bits;
+    if lo < 0 { Some(i128::from(((raw << unused) as i64) >> unused)) } else { Some(i128::from(raw)) }
 }
 
 /// Copies `value[offset..]` into `buf` (segmented and partial reads).
