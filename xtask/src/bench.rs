@@ -142,14 +142,21 @@ fn check_exit(r: &QemuRun) -> Result {
 }
 
 /// `cargo xtask test`'s self-test: the bench image, without the plugin, must check every
-/// answer and exit with code 0.
-pub fn selftest() -> Result {
+/// answer and exit with code 0. Returns the deepest stack use it measured (bytes).
+pub fn selftest() -> Result<u64> {
     let elf = build_image()?;
     let r = qemu(&elf, &[])?;
     check_exit(&r)?;
     let scenarios = r.stdout.lines().filter(|l| l.starts_with("bench ")).count();
-    println!("xtask: bench image self-test passed: {scenarios} scenarios, every answer as expected");
-    Ok(())
+    let peak = r
+        .stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("stack-peak-bytes: ").or_else(|| l.strip_prefix("stack-peak-setup-bytes: ")))
+        .filter_map(|n| n.trim().parse::<u64>().ok())
+        .max()
+        .ok_or("the bench image reported no stack peak")?;
+    println!("xtask: bench image self-test passed: {scenarios} scenarios, every answer as expected; stack peak {peak} bytes");
+    Ok(peak)
 }
 
 /// One measured scenario.
@@ -339,7 +346,7 @@ fn size_report() -> Result<String> {
 pub fn main(args: &[String]) -> Result {
     match args {
         [] => report(),
-        [flag] if flag == "--selftest" => selftest(),
+        [flag] if flag == "--selftest" => selftest().map(|_| ()),
         _ => Err("usage: cargo xtask bench [--selftest]".into()),
     }
 }

@@ -6,16 +6,22 @@ use std::process::Command;
 
 /// Sizes of the allocated sections of an ELF32 little-endian image.
 #[derive(Debug, Default, Clone, Copy)]
-struct Sections {
-    text: u64,
-    rodata: u64,
-    data: u64,
-    bss: u64,
+pub struct Sections {
+    pub text: u64,
+    pub rodata: u64,
+    pub data: u64,
+    pub bss: u64,
 }
 
 impl Sections {
-    fn flash(self) -> u64 {
+    /// What the image takes in flash: code, constants and the initial values of variables.
+    pub fn flash(self) -> u64 {
         self.text + self.rodata + self.data
+    }
+
+    /// Static RAM: variables with and without initial values.
+    pub fn ram(self) -> u64 {
+        self.data + self.bss
     }
 }
 
@@ -28,7 +34,7 @@ fn u32_at(b: &[u8], at: usize) -> u64 {
 }
 
 /// Reads the section table; names come from the section-name string table.
-fn sections(elf: &[u8]) -> std::result::Result<Sections, String> {
+pub fn sections(elf: &[u8]) -> std::result::Result<Sections, String> {
     if elf.get(..4) != Some(b"\x7fELF") || elf.get(4) != Some(&1) || elf.get(5) != Some(&1) {
         return Err("not a 32-bit little-endian ELF file".into());
     }
