@@ -342,17 +342,19 @@ fn size_report() -> Result<String> {
     Ok(text.lines().filter(|l| !l.starts_with("xtask: $")).map(|l| l.strip_prefix("xtask: ").unwrap_or(l)).collect::<Vec<_>>().join("\n"))
 }
 
-/// `cargo xtask bench [--selftest]`: the whole report, or only the self-test.
+/// `cargo xtask bench [--selftest | --instructions]`: the whole report, only the self-test, or
+/// only the instruction counts.
 pub fn main(args: &[String]) -> Result {
     match args {
         [] => report(),
         [flag] if flag == "--selftest" => selftest().map(|_| ()),
-        _ => Err("usage: cargo xtask bench [--selftest]".into()),
+        [flag] if flag == "--instructions" => instructions().map(|table| println!("{table}")),
+        _ => Err("usage: cargo xtask bench [--selftest | --instructions]".into()),
     }
 }
 
-/// Instruction counts, criterion figures and the size report into `target/bench/report.md`.
-pub fn report() -> Result {
+/// The instruction counts per scenario, as a Markdown table.
+fn instructions() -> Result<String> {
     setup::rust_targets()?;
     let plugin = build_plugin()?;
     let elf = build_image()?;
@@ -363,7 +365,12 @@ pub fn report() -> Result {
     let r = qemu(&elf, &["-d".into(), "plugin".into(), "-plugin".into(), plugin_arg])?;
     check_exit(&r)?;
     let counts = parse(&r.stdout, &r.stderr)?;
-    let table = instruction_table(&counts);
+    Ok(instruction_table(&counts))
+}
+
+/// Instruction counts, criterion figures and the size report into `target/bench/report.md`.
+pub fn report() -> Result {
+    let table = instructions()?;
 
     println!("xtask: criterion benchmarks ({})", CRITERION_ARGS.join(" "));
     let estimates = criterion()?;

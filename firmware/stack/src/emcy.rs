@@ -89,16 +89,19 @@ pub struct EmcyProducer {
     /// Bytes 3..7 of every frame carry the OR of the active errors' manufacturer bytes
     /// (frenzel+berg CO40xx codes: "the bitmap of all active errors is combined with OR").
     combine: bool,
+    /// Counts changes of the active set (raise, clear, reset), wrapping: a byte, since a
+    /// reader compares it after every input, never 256 changes apart.
+    changes: u8,
 }
 
 impl EmcyProducer {
     pub const fn new() -> Self {
-        EmcyProducer { active: Vec::new(), queue: Deque::new(), last_sent_us: None, dropped: 0, combine: false }
+        EmcyProducer { active: Vec::new(), queue: Deque::new(), last_sent_us: None, dropped: 0, combine: false, changes: 0 }
     }
 
     /// A producer whose frames carry the OR of every active error's manufacturer bytes.
     pub const fn combining() -> Self {
-        EmcyProducer { active: Vec::new(), queue: Deque::new(), last_sent_us: None, dropped: 0, combine: true }
+        EmcyProducer { active: Vec::new(), queue: Deque::new(), last_sent_us: None, dropped: 0, combine: true, changes: 0 }
     }
 
     /// The manufacturer bytes of a frame sent now: the raised error's own (`own`), or the OR
@@ -123,6 +126,12 @@ impl EmcyProducer {
         self.active.iter().any(|a| a.is(e))
     }
 
+    /// How often the set of active errors changed (raise, clear, reset; wrapping): whoever
+    /// mirrors conditions into errors needs to look again only when this moved.
+    pub const fn changes(&self) -> u8 {
+        self.changes
+    }
+
     /// Raises an error; `None` if it was already active (nothing is sent twice).
     pub fn raise(&mut self, e: &EmcyDefault) -> Option<Change> {
         if self.is_active(e) {
@@ -130,6 +139,7 @@ impl EmcyProducer {
         }
         // A full table still reports the error; it only cannot be cleared individually.
         let _ = self.active.push(Active { code: e.code, register: e.register, manufacturer: e.manufacturer, event: e.event });
+        self.changes = self.changes.wrapping_add(1);
         let register = self.register();
         self.enqueue(e.code, register, self.manufacturer(e.manufacturer));
         Some(Change { register, history: Some(u32::from(e.code) | u32::from(e.manufacturer[0]) << 16 | u32::from(e.manufacturer[1]) << 24) })
@@ -144,6 +154,7 @@ impl EmcyProducer {
         if let Some(slot) = self.active.get_mut(at) {
             *slot = last;
         }
+        self.changes = self.changes.wrapping_add(1);
         let register = self.register();
         self.enqueue(0x0000, register, self.manufacturer([0; 5]));
         Some(Change { register, history: None })
@@ -152,6 +163,7 @@ impl EmcyProducer {
     /// Forgets every active error without sending anything (NMT reset).
     pub fn reset(&mut self) {
         self.active.clear();
+        self.changes = self.changes.wrapping_add(1);
         self.queue.clear();
         self.last_sent_us = None;
     }

@@ -328,16 +328,15 @@ pub fn find(entries: &[EntryInfo], index: u16, sub: u8) -> Result<&EntryInfo, Sd
 pub fn find_run(entries: &[EntryInfo], index: u16, sub: u8) -> Result<usize, SdoAbort> {
     // The object: the last run listed at or before `index` must describe it.
     let listed = entries.partition_point(|e| e.index <= index);
-    let first = match listed.checked_sub(1).and_then(|i| entries.get(i)) {
+    let last = listed.checked_sub(1).ok_or(SdoAbort::NoObject)?;
+    let first = match entries.get(last) {
         Some(e) if e.covers_index(index) => e.index,
         _ => return Err(SdoAbort::NoObject),
     };
-    // The sub-index: the last of the object's runs that starts at or before it.
-    let after = entries.partition_point(|e| (e.index, e.sub) <= (first, sub));
-    match after.checked_sub(1).and_then(|i| entries.get(i).map(|e| (i, e))) {
-        Some((i, e)) if e.index == first && e.covers(sub) => Ok(i),
-        _ => Err(SdoAbort::NoSubIndex),
-    }
+    // The sub-index: the object's runs end at `last` and are few, so a scan back is quicker
+    // than a second search.
+    let runs = entries.get(..listed).unwrap_or_default().iter().enumerate().rev().take_while(|(_, e)| e.index == first);
+    runs.filter(|(_, e)| e.covers(sub)).map(|(i, _)| i).next().ok_or(SdoAbort::NoSubIndex)
 }
 
 /// The dictionary of one device: implemented by the code `device!` generates.

@@ -34,6 +34,11 @@ pub struct Memory1<S, B> {
     /// The bank status last reported (EMCY, TPDO1, outputs).
     reported: [BankStatus; 2],
     outputs: StatusOutputs,
+    /// The conditions last mirrored into emergencies, and the node's error-change count right
+    /// after: nothing to do while both stay the same.
+    emcy_synced: Option<([bool; 4], u8)>,
+    /// The millisecond `poll` last sampled the supply in.
+    polled_ms: u64,
     next_scrub_us: u64,
     /// Serial frames that were not a command of the protocol.
     pub(crate) host_rejects: u32,
@@ -55,6 +60,8 @@ impl<S: Storage, B: Board> Memory1<S, B> {
             bus_off: false,
             reported: [BankStatus::default(); 2],
             outputs: StatusOutputs::default(),
+            emcy_synced: None,
+            polled_ms: u64::MAX,
             next_scrub_us: SCRUB_PERIOD_US,
             host_rejects: 0,
         })
@@ -84,12 +91,19 @@ impl<S: Storage, B: Board> Memory1<S, B> {
 
     /// Runs the timers, the supply guard and the scrub; returns the next frame to send.
     pub fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
-        if now_us >= self.next_scrub_us {
+        let scrub = now_us >= self.next_scrub_us;
+        if scrub {
             self.next_scrub_us = now_us.saturating_add(SCRUB_PERIOD_US);
-            // A lost block shows in the bank status; nothing more to do here.
+            // A lost block shows in the bank status, which the update below reports.
             let _ = self.node.od_mut().app.banks_mut().scrub_next();
         }
-        self.update(false);
+        // Every other input updates after itself; here only the supply can have moved, and
+        // sampling it once a millisecond is plenty (it falls over milliseconds, not cycles).
+        let now_ms = now_us / 1000;
+        if scrub || now_ms != self.polled_ms {
+            self.polled_ms = now_ms;
+            self.update(false);
+        }
         if !self.bus_off
             && let Some(frame) = self.raw_tx.pop_front()
         {
@@ -174,18 +188,18 @@ impl<S: Storage, B: Board> Memory1<S, B> {
         od.system_configuration = self.config.system_configuration;
         let status = [od.app.status(0), od.app.status(1)];
         let [bank1, bank2] = status;
-        let conditions = [
-            (&emcy::MEMORY_BANK1_ERROR, bank1.is_error()),
-            (&emcy::MEMORY_BANK2_ERROR, bank2.is_error()),
-            (&emcy::VOLTAGE_LOW, self.supply >= Supply::Low),
-            (&emcy::VOLTAGE_LOW_CRITICAL, self.supply >= Supply::Critical),
-        ];
-        for (e, active) in conditions {
-            match (active, self.node.is_active(e)) {
-                (true, false) => self.node.raise(e),
-                (false, true) => self.node.clear(e),
-                _ => {}
+        let active = [bank1.is_error(), bank2.is_error(), self.supply >= Supply::Low, self.supply >= Supply::Critical];
+        // An NMT reset forgets the emergencies and changes the count: they are raised again.
+        if self.emcy_synced != Some((active, self.node.error_changes())) {
+            let emergencies = [&emcy::MEMORY_BANK1_ERROR, &emcy::MEMORY_BANK2_ERROR, &emcy::VOLTAGE_LOW, &emcy::VOLTAGE_LOW_CRITICAL];
+            for (e, active) in emergencies.into_iter().zip(active) {
+                match (active, self.node.is_active(e)) {
+                    (true, false) => self.node.raise(e),
+                    (false, true) => self.node.clear(e),
+                    _ => {}
+                }
             }
+            self.emcy_synced = Some((active, self.node.error_changes()));
         }
         if status != self.reported || force {
             self.reported = status;

@@ -309,6 +309,13 @@ impl<D: Dictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N,
         self.core.emcy.is_active(e)
     }
 
+    /// How often the set of active errors changed (raise, clear, NMT reset; wrapping). A
+    /// device that mirrors conditions into emergencies syncs them only when its conditions or
+    /// this count moved, instead of asking [`Node::is_active`] after every input.
+    pub fn error_changes(&self) -> u8 {
+        self.core.emcy.changes()
+    }
+
     /// The current error register (1001h).
     pub fn error_register(&self) -> u8 {
         self.core.emcy.register()
