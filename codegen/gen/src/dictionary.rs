@@ -210,7 +210,8 @@ fn plain_field(e: &Entry, field: &Ident, doc: &str, index: u16, number: &proc_ma
     parts.place(e, index, quote!(self.#field), ty.clone(), init);
     parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
     parts.names.push(field.clone());
-    parts.field_arms.push(quote!((#number, 0) => &mut self.#field));
+    // The caller has found `sub` in this entry's run, so a single field needs no sub test.
+    parts.field_arms.push(quote!((#number, _) => &mut self.#field));
 }
 
 /// The class of an index: resets test one index per run of places in the same class, since
@@ -247,6 +248,8 @@ fn reset_groups(resets: &[Place]) -> Vec<TokenStream> {
 pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
     let stack = &options.stack;
     let block_transfer = d.identity.sdo_block_transfer;
+    let has = |index: u16| d.objects.iter().any(|o| o.index == index);
+    let (history, sync_cycle, consumer) = (has(0x1003), has(0x1006), has(0x1016));
     let mut parts = Parts { structs: Vec::new(), fields: Vec::new(), names: Vec::new(), field_arms: Vec::new(), persist: Vec::new(), resets: Vec::new() };
     for slot in slots(d) {
         slot_parts(&slot, stack, &mut parts);
@@ -286,6 +289,8 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
         impl<A: #stack::od::AppObjects> #stack::od::Dictionary for Od<A> {
             const PERSISTENT_SIZE: usize = 0 #(+ <#types as #stack::value::Persist>::SIZE)*;
             const SDO_BLOCK_TRANSFER: bool = #block_transfer;
+            const COMM: #stack::od::CommObjects =
+                #stack::od::CommObjects { error_history: #history, sync_cycle: #sync_cycle, heartbeat_consumer: #consumer };
 
             #[allow(unused_mut, unused_variables)]
             fn save_area(&self, area: #stack::od::Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {

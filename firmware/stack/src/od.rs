@@ -351,8 +351,9 @@ pub trait ObjectDictionary {
     /// Every entry description, sorted by index and sub-index (see [`find`]).
     fn entries(&self) -> &'static [EntryInfo];
 
-    /// The field that stores `sub` of the entry `info` describes; `None` for an entry the
-    /// dictionary does not store (app-backed ones).
+    /// The field that stores `sub` of the entry `info` describes, `info` being the run
+    /// [`find_run`] gave for it (so `info.covers(sub)`; single-entry objects do not look at
+    /// `sub` again); `None` for an entry the dictionary does not store (app-backed ones).
     fn field(&mut self, info: &EntryInfo, sub: u8) -> Option<&mut dyn OdValue>;
 
     /// The device's app-backed objects.
@@ -432,6 +433,23 @@ impl Area {
     }
 }
 
+/// Optional communication objects whose services cost code: a dictionary without one (in
+/// every mode) leaves that code out of the image, since the stack tests these constants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CommObjects {
+    /// 1003h, the pre-defined error field (error history).
+    pub error_history: bool,
+    /// 1006h, the communication cycle period (SYNC timeout monitoring).
+    pub sync_cycle: bool,
+    /// 1016h, the consumer heartbeat times.
+    pub heartbeat_consumer: bool,
+}
+
+impl CommObjects {
+    /// Every service, as for a dictionary that has every object.
+    pub const ALL: CommObjects = CommObjects { error_history: true, sync_cycle: true, heartbeat_consumer: true };
+}
+
 /// What a node needs from a generated dictionary besides reads and writes: the spec
 /// defaults, the persistent block and the emergencies.
 pub trait Dictionary: ObjectDictionary {
@@ -440,6 +458,9 @@ pub trait Dictionary: ObjectDictionary {
 
     /// Whether the SDO server does block transfer (the spec's `sdo_block_transfer`).
     const SDO_BLOCK_TRANSFER: bool;
+
+    /// The optional communication objects the dictionary has in any mode.
+    const COMM: CommObjects;
 
     /// Hands the image of every persistent entry of `area` to `sink` with its offset in the
     /// block, so the block is written without a buffer of its size; `false` if `sink` failed.

@@ -37,8 +37,8 @@ pub struct Memory1<S, B> {
     /// The conditions last mirrored into emergencies, and the node's error-change count right
     /// after: nothing to do while both stay the same.
     emcy_synced: Option<([bool; 4], u8)>,
-    /// The millisecond `poll` last sampled the supply in.
-    polled_ms: u64,
+    /// When `poll` samples the supply next.
+    next_sample_us: u64,
     next_scrub_us: u64,
     /// Serial frames that were not a command of the protocol.
     pub(crate) host_rejects: u32,
@@ -61,7 +61,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
             reported: [BankStatus::default(); 2],
             outputs: StatusOutputs::default(),
             emcy_synced: None,
-            polled_ms: u64::MAX,
+            next_sample_us: 0,
             next_scrub_us: SCRUB_PERIOD_US,
             host_rejects: 0,
         })
@@ -75,6 +75,8 @@ impl<S: Storage, B: Board> Memory1<S, B> {
 
     /// A frame from the bus. Frames on the monitored identifier go to the monitoring channel.
     pub fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
+        // The frame may write the memory: the guard must know the supply of this moment.
+        self.sample_supply();
         let monitored = monitored_id(self.node.od().rpdo2_comm.cob_id_used_by_rpdo);
         if monitored == Some(frame.id) && !frame.rtr {
             self.monitor.capture(frame.payload());
@@ -99,9 +101,9 @@ impl<S: Storage, B: Board> Memory1<S, B> {
         }
         // Every other input updates after itself; here only the supply can have moved, and
         // sampling it once a millisecond is plenty (it falls over milliseconds, not cycles).
-        let now_ms = now_us / 1000;
-        if scrub || now_ms != self.polled_ms {
-            self.polled_ms = now_ms;
+        // (No division: a 64-bit one costs a Cortex-M0 1 KiB of flash.)
+        if scrub || now_us >= self.next_sample_us {
+            self.next_sample_us = now_us.saturating_add(1000);
             self.update(false);
         }
         if !self.bus_off
@@ -131,6 +133,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
             }
         };
         let frame = coforge_link::Frame { code, length_code: None, network: None, data: data.get(..len).unwrap_or(&[]) };
+        self.sample_supply();
         let n = self.answer(&frame, out);
         self.update(false);
         n
@@ -176,15 +179,21 @@ impl<S: Storage, B: Board> Memory1<S, B> {
         &mut self.board
     }
 
-    /// Brings everything derived from the banks, the supply and the monitor up to date: the
-    /// write guard, 5F00h, 2101h, 2105h, the emergencies, TPDO1 and the status outputs. The
-    /// emergencies follow the conditions, so an NMT reset that forgets them raises them again.
-    fn update(&mut self, force: bool) {
+    /// Reads the supply: 5F00h and the write guard.
+    fn sample_supply(&mut self) {
         let mv = self.board.supply_mv();
         self.supply = self.supply.next(mv);
         let od = self.node.od_mut();
         od.app.set_writes_allowed(self.supply.writes_allowed());
         od.supply_voltage_monitor = mv;
+    }
+
+    /// Brings everything derived from the banks, the supply and the monitor up to date: the
+    /// write guard, 5F00h, 2101h, 2105h, the emergencies, TPDO1 and the status outputs. The
+    /// emergencies follow the conditions, so an NMT reset that forgets them raises them again.
+    fn update(&mut self, force: bool) {
+        self.sample_supply();
+        let od = self.node.od_mut();
         od.system_configuration = self.config.system_configuration;
         let status = [od.app.status(0), od.app.status(1)];
         let [bank1, bank2] = status;

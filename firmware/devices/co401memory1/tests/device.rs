@@ -361,3 +361,15 @@ fn block_transfer_is_refused_as_an_unknown_command_and_segmented_transfer_still_
     // Nothing was stored by the refused download.
     assert_eq!(rig.upload(0x5000, 1), Ok(0));
 }
+
+#[test]
+fn a_supply_drop_between_polls_already_refuses_the_next_write() {
+    // The guard samples the supply when a write arrives, not only in `poll`.
+    let mut rig = Rig::new();
+    rig.download(0x5000, 1, &[0x11]).unwrap();
+    rig.dev.board_mut().supply_mv = 14_000;
+    // No poll between the drop and the SDO request.
+    assert_eq!(rig.download(0x5000, 1, &[0x22]), Err(0x0800_0022));
+    rig.dev.board_mut().supply_mv = 24_000;
+    assert_eq!(rig.upload(0x5000, 1), Ok(0x11), "nothing stored changed");
+}

@@ -26,7 +26,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             (0x1003, 0) if value != 0 => Err(SdoAbort::InvalidValue),
             (0x1005, 0) if value & (1 << 30 | COB_EXTENDED) != 0 => Err(SdoAbort::InvalidValue),
             (0x1014, 0) => self.check_cob_change(0x1014, 0, value),
-            (0x1016, 1..) => self.check_consumer(sub, value),
+            (0x1016, 1..) if D::COMM.heartbeat_consumer => self.check_consumer(sub, value),
             _ => match Dir::of_index(index) {
                 Some((dir, false, _)) => self.check_pdo_comm(dir, index, sub, value, side),
                 Some((dir, true, _)) => self.check_pdo_mapping(dir, index, sub, value, side),

@@ -90,7 +90,9 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
         let Some(change) = self.emcy.raise(e) else { return };
         self.mirror_error_register(change.register);
-        if let Some(entry) = change.history {
+        if D::COMM.error_history
+            && let Some(entry) = change.history
+        {
             self.push_history(entry);
         }
         // Sent before the reaction: an error that stops the node must still be reported.

@@ -458,7 +458,9 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             return;
         }
         if (0x701..=0x77F).contains(&frame.id) && !frame.rtr {
-            if let [code] = frame.payload() {
+            if D::COMM.heartbeat_consumer
+                && let [code] = frame.payload()
+            {
                 let node = (frame.id - 0x700) as u8;
                 match self.consumer.on_heartbeat(node, *code, now_us) {
                     Some(ConsumerEvent::Recovered(_)) => self.clear_event(EmcyEvent::HeartbeatTimeout),
@@ -490,7 +492,9 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             Some(GuardEvent::Warning) => self.raise_event(EmcyEvent::GuardingWarning),
             None => {}
         }
-        if let Some(ConsumerEvent::Lost(_)) = self.consumer.check(now_us) {
+        if D::COMM.heartbeat_consumer
+            && let Some(ConsumerEvent::Lost(_)) = self.consumer.check(now_us)
+        {
             self.raise_event(EmcyEvent::HeartbeatTimeout);
         }
         self.check_deadlines(now_us);

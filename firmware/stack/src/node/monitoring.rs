@@ -30,7 +30,8 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     /// SYNC cycle (1006h) and RPDO deadline monitoring.
     pub(super) fn check_deadlines(&mut self, now_us: u64) {
         let period = u64::from(self.sync_period_us);
-        if period != 0
+        if D::COMM.sync_cycle
+            && period != 0
             && nmt::allows_emcy_and_sync(self.state)
             && !self.sync_lost
             && self.last_sync_us.is_some_and(|t| now_us.saturating_sub(t) > period + period / 2)
@@ -85,7 +86,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
 
     pub(super) fn reload_sync(&mut self) {
         self.sync_cob = read_u32(&mut self.od, 0x1005, 0).map(|c| (c & 0x7FF) as u16).or(Some(0x080));
-        self.sync_period_us = read_u32(&mut self.od, 0x1006, 0).unwrap_or(0);
+        self.sync_period_us = if D::COMM.sync_cycle { read_u32(&mut self.od, 0x1006, 0).unwrap_or(0) } else { 0 };
     }
 
     pub(super) fn reload_emcy(&mut self) {
@@ -112,6 +113,9 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     }
 
     pub(super) fn reload_consumer(&mut self) {
+        if !D::COMM.heartbeat_consumer {
+            return;
+        }
         let count = read_u32(&mut self.od, 0x1016, 0).unwrap_or(0).min(127) as u8;
         let od = &mut self.od;
         let entries = (1..=count).map(|sub| read_u32(od, 0x1016, sub).unwrap_or(0));
