@@ -1,4 +1,4 @@
-//! A millisecond clock: SysTick interrupts every millisecond and counts.
+//! A millisecond clock from SysTick's counter.
 
 /// The core clock QEMU gives the lm3s6965evb after reset (the 12 MHz main oscillator).
 pub const CORE_HZ: u32 = 12_000_000;

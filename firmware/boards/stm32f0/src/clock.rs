@@ -1,4 +1,4 @@
-//! A millisecond clock: SysTick interrupts every millisecond and counts. [`MsDelay`] waits on
+//! A millisecond clock from SysTick's counter. [`MsDelay`] waits on
 //! it (the 5 ms EEPROM write cycle).
 
 /// The core clock the image sets up: 48 MHz (HSE 8 MHz x 6, or HSI48).
