@@ -70,6 +70,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
     /// Power-on: boot-up message, then pre-operational.
     pub fn start(&mut self, now_us: u64) {
         self.node.start(now_us);
+        self.sample_supply();
         self.update(true);
     }
 
@@ -104,6 +105,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
         // (No division: a 64-bit one costs a Cortex-M0 1 KiB of flash.)
         if scrub || now_us >= self.next_sample_us {
             self.next_sample_us = now_us.saturating_add(1000);
+            self.sample_supply();
             self.update(false);
         }
         if !self.bus_off
@@ -143,6 +145,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
     pub fn on_bus_state(&mut self, bus: BusState, now_us: u64) {
         self.bus_off = bus == BusState::BusOff;
         self.node.on_bus_state(bus, now_us);
+        self.sample_supply();
         self.update(false);
     }
 
@@ -188,11 +191,12 @@ impl<S: Storage, B: Board> Memory1<S, B> {
         od.supply_voltage_monitor = mv;
     }
 
-    /// Brings everything derived from the banks, the supply and the monitor up to date: the
-    /// write guard, 5F00h, 2101h, 2105h, the emergencies, TPDO1 and the status outputs. The
+    /// Brings everything derived from the banks, the supply state last sampled and the monitor
+    /// up to date: 2101h, 2105h, the emergencies, TPDO1 and the status outputs. The
     /// emergencies follow the conditions, so an NMT reset that forgets them raises them again.
+    /// Every input samples the supply before it acts (a write must see the supply of its
+    /// moment) and updates after.
     fn update(&mut self, force: bool) {
-        self.sample_supply();
         let od = self.node.od_mut();
         od.system_configuration = self.config.system_configuration;
         let status = [od.app.status(0), od.app.status(1)];

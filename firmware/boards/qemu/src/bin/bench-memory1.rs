@@ -19,6 +19,7 @@
 
 use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
 use coforge_stack::frame::CanFrame;
+use coforge_stack::od::Side;
 use coforge_storage::ram::BorrowedEeprom;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
@@ -88,7 +89,7 @@ fn drain(device: &mut Device) -> Answers {
 
 /// The scenarios' names by id, printed at the end: a print between scenarios would go deeper
 /// into the stack than the module and spoil the stack peak.
-const NAMES: [&str; 8] = [
+const NAMES: [&str; 9] = [
     "calibration (empty)",
     "sdo-expedited-upload 1018.1",
     "sdo-expedited-download 2180.0 (u16)",
@@ -97,6 +98,7 @@ const NAMES: [&str; 8] = [
     "rpdo1 6200.1/6200.2 = 0x91 (clear bank status)",
     "sync (two synchronous TPDOs)",
     "serial read-memory 33 12 50 04",
+    "rpdo1 6200.1/6200.2 = 0x00 (no command: the RPDO path alone)",
 ];
 
 /// Runs `work` between the markers as scenario `id` (its name is `NAMES[id]`).
@@ -274,6 +276,19 @@ fn main() -> ! {
     if out.get(..n) != Some(&[0x32, 0x01, 0x23][..]) {
         hprintln!("bench: serial answer {:02x?}", out.get(..n).unwrap_or(&[]));
         fail("serial Read Memory 5012.04: expected 32 01 23", &Answers { frames: [frame(0, &[]); 4], n: 0 });
+    }
+
+    // RPDO1 again with command bytes that mean nothing: the stack's RPDO path (match the
+    // COB-ID, unpack the mapping, two app writes) without the banks' work; nothing is sent.
+    let request = frame(0x200 + u16::from(NODE_ID), &[0x00, 0x00]);
+    let answers = measure(8, || exchange(device, &request));
+    expect("RPDO1 0x00 0x00: nothing to send", &answers, &[]);
+    let mut command = [0xFF_u8; 1];
+    for sub in [1, 2] {
+        let read = device.node_mut().read(0x6200, sub, 0, &mut command, Side::Device);
+        if read.is_err() || command != [0] {
+            fail("RPDO1 0x00 0x00: command bytes not stored", &answers);
+        }
     }
 
     let peak = stack_peak();
