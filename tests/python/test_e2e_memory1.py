@@ -26,6 +26,8 @@ from bus import Recorder
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 QEMU_IMAGE = os.environ.get("COFORGE_QEMU_IMAGE", str(ROOT / "firmware/boards/qemu/target/thumbv7m-none-eabi/release/co401memory1"))
+# The image that keeps its banks in host files (semihosting), beside the plain one.
+FILES_IMAGE = str(pathlib.Path(QEMU_IMAGE).resolve().with_name(pathlib.Path(QEMU_IMAGE).name.replace("co401memory1", "co401memory1-files", 1)))
 NODE_ID = 5  # the QEMU board's ID pins; the simulator derives its pins from --node-id
 WAIT = 10.0
 
@@ -50,7 +52,7 @@ def connect(port, timeout=WAIT):
 class Target:
     """A running CO401Memory1: `can_url` for python-can, `serial` a connected socket."""
 
-    def __init__(self, kind):
+    def __init__(self, kind, image=QEMU_IMAGE, cwd=None):
         self.kind = kind
         if kind == "sim":
             self.proc = subprocess.Popen(
@@ -62,14 +64,14 @@ class Target:
             assert serial and can, "coforge sim banner"
             self.can_url, serial_port = can.group(1), int(serial.group(1))
         else:
-            assert pathlib.Path(QEMU_IMAGE).exists(), f"no QEMU image at {QEMU_IMAGE}: run `cargo xtask test`"
+            assert pathlib.Path(image).exists(), f"no QEMU image at {image}: run `cargo xtask test`"
             serial_port, can_port = free_port(), free_port()
             self.proc = subprocess.Popen(
                 ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", "none",
-                 "-semihosting-config", "enable=on,target=native", "-kernel", QEMU_IMAGE,
+                 "-semihosting-config", "enable=on,target=native", "-kernel", image,
                  "-serial", f"tcp:127.0.0.1:{serial_port},server=on,wait=off,nodelay=on",
                  "-serial", f"tcp:127.0.0.1:{can_port},server=on,wait=off,nodelay=on"],
-                stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, cwd=cwd,
             )
             # The simulator's hub connects to the image's UART1 (an SLCAN adapter of its own
             # node) and python-canopen joins the hub, as it joins `coforge sim`.
@@ -183,3 +185,24 @@ def test_serial_datasheet_examples(target):
     mark = target.rec.mark()
     assert exchange(target, "D5 23 01 B1 B2 B3", 2) == "D1 01"
     assert target.rec.wait(0x123, mark, WAIT, lambda f: f.data == bytes.fromhex("B1 B2 B3")), "transmitted"
+
+
+def test_banks_in_host_files_survive_a_restart_of_the_image(tmp_path):
+    """The `-files` image keeps its banks in `co401memory1.bank1`/`.bank2` in QEMU's working
+    directory: a byte written over the serial line is there after QEMU is stopped and started
+    again, and the files mount clean (status 0) instead of as new blank banks (0x40)."""
+    first = Target("qemu", image=FILES_IMAGE, cwd=tmp_path)
+    try:
+        assert exchange(first, "00", 5) == "04 40 40 03 00", "new files: blank banks, cleared"
+        assert exchange(first, "44 12 50 04 23", 2) == "41 01"
+        assert exchange(first, "33 12 50 04", 3) == "32 01 23"
+    finally:
+        first.close()
+    sizes = {f.name: f.stat().st_size for f in tmp_path.iterdir()}
+    assert sizes == {"co401memory1.bank1": 8448, "co401memory1.bank2": 8448}
+    second = Target("qemu", image=FILES_IMAGE, cwd=tmp_path)
+    try:
+        assert exchange(second, "33 12 50 04", 3) == "32 01 23", "the byte survived the restart"
+        assert exchange(second, "00", 5) == "04 00 00 00 00", "both banks mounted clean"
+    finally:
+        second.close()

@@ -76,6 +76,11 @@ impl<'a> BorrowedEeprom<'a> {
         BorrowedEeprom { bytes }
     }
 
+    /// Uses `bytes` as they are: an image loaded from elsewhere.
+    pub fn holding(bytes: &'a mut [u8]) -> Self {
+        BorrowedEeprom { bytes }
+    }
+
     fn range(&self, offset: u32, len: usize) -> Result<core::ops::Range<usize>, OutOfBounds> {
         let start = usize::try_from(offset).map_err(|_| OutOfBounds)?;
         let end = start.checked_add(len).filter(|&e| e <= self.bytes.len()).ok_or(OutOfBounds)?;

@@ -1,0 +1,38 @@
+//! The images' main loop: the serial host protocol on UART0, the module's CAN side as an
+//! SLCAN adapter on UART1 (frames a host sends are what the node receives, frames the node
+//! sends come back as SLCAN lines).
+
+use crate::clock;
+use crate::uart::{UART0, UART1, Uart};
+use co401memory1::{FixedBoard, Memory1};
+use coforge_stack::slcan::{self, Command};
+use embedded_storage::Storage;
+
+/// Starts the module and serves both UARTs for ever.
+pub fn run<S: Storage>(device: &mut Memory1<S, FixedBoard>) -> ! {
+    let (host, can) = (Uart::new(UART0), Uart::new(UART1));
+    device.start(0);
+    let mut lines = slcan::Decoder::new();
+    let mut answer = [0_u8; 16];
+    let mut line = [0_u8; slcan::MAX_FRAME_LINE];
+    loop {
+        let ms = clock::millis();
+        let now_us = u64::from(ms) * 1000;
+        while let Some(byte) = host.read() {
+            let n = device.on_serial_byte(byte, ms, &mut answer);
+            host.write(answer.get(..n).unwrap_or(&[]));
+        }
+        while let Some(byte) = can.read() {
+            if let Some(cmd) = lines.push(byte) {
+                if let Command::Frame(frame) = cmd {
+                    device.on_frame(&frame, now_us);
+                }
+                can.write(slcan::reply(&cmd));
+            }
+        }
+        while let Some(frame) = device.poll(now_us) {
+            let n = slcan::encode(&frame, &mut line);
+            can.write(line.get(..n).unwrap_or(&[]));
+        }
+    }
+}
