@@ -12,25 +12,18 @@
 #![no_std]
 #![no_main]
 
-use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
+use co401memory1::BANK_SIZE;
 use coforge_board_qemu::host_file::HostFileEeprom;
-use coforge_board_qemu::{clock, serve};
 use cortex_m_rt::entry;
 use panic_semihosting as _;
-
-type Device = Memory1<HostFileEeprom<'static>, FixedBoard>;
 
 #[entry]
 fn main() -> ! {
     // The banks' RAM images, in .bss (cortex-m-rt makes them `&'static mut`, no unsafe).
     static mut BANK1: [u8; BANK_SIZE] = [0; BANK_SIZE];
     static mut BANK2: [u8; BANK_SIZE] = [0; BANK_SIZE];
-    let Some(core) = cortex_m::Peripherals::take() else { panic!("peripherals taken twice") };
-    clock::start(core.SYST);
     let (Ok(bank1), Ok(bank2)) = (HostFileEeprom::open("co401memory1.bank1\0", BANK1), HostFileEeprom::open("co401memory1.bank2\0", BANK2)) else {
         panic!("cannot open the bank files (is semihosting enabled?)")
     };
-    let Ok(device) = Memory1::new([bank1, bank2], FixedBoard::new(5)) else { panic!("reserved configuration pins") };
-    let Some(device) = cortex_m::singleton!(: Device = device) else { panic!("started twice") };
-    serve::run(device)
+    coforge_board_qemu::serve_memory1!(HostFileEeprom<'static>, [bank1, bank2])
 }

@@ -9,14 +9,10 @@
 #![no_std]
 #![no_main]
 
-use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
-use coforge_board_qemu::{clock, serve};
+use co401memory1::BANK_SIZE;
 use coforge_storage::ram::BorrowedEeprom;
 use cortex_m_rt::entry;
 use panic_semihosting as _;
-
-/// Node-ID 5 on the ID pins, 1 Mbit/s, 9600 baud, a 24 V supply.
-type Device = Memory1<BorrowedEeprom<'static>, FixedBoard>;
 
 #[entry]
 fn main() -> ! {
@@ -24,13 +20,5 @@ fn main() -> ! {
     // module only borrows them, so nothing large is built on the stack.
     static mut BANK1: [u8; BANK_SIZE] = [0; BANK_SIZE];
     static mut BANK2: [u8; BANK_SIZE] = [0; BANK_SIZE];
-    let Some(core) = cortex_m::Peripherals::take() else { panic!("peripherals taken twice") };
-    clock::start(core.SYST);
-    let Ok(device) = Memory1::new([BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)], FixedBoard::new(5)) else {
-        panic!("reserved configuration pins")
-    };
-    // In a `MaybeUninit` static (.bss): an `Option` static would sit in .data, a second copy
-    // of the module in flash.
-    let Some(device) = cortex_m::singleton!(: Device = device) else { panic!("started twice") };
-    serve::run(device)
+    coforge_board_qemu::serve_memory1!(BorrowedEeprom<'static>, [BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)])
 }
