@@ -40,16 +40,21 @@ pub fn run<S: Storage>(device: &mut Memory1<S, FixedBoard>) -> ! {
 /// The body of each CO401Memory1 image's `main`: takes the core peripherals, starts the
 /// clock, builds the module on `banks` (node-ID 5 on the pins, 1 Mbit/s, 9600 baud, 24 V) in
 /// a `MaybeUninit` static and serves it. A macro, since `singleton!` needs the module's
-/// concrete type (an `Option` static would sit in .data: a second copy of it in flash).
+/// concrete type (an `Option` static would sit in .data: a second copy of it in flash). The
+/// module is built in a function of its own, so that its construction's temporaries (about
+/// 1.3 KiB) leave the stack before the loop starts.
 #[macro_export]
 macro_rules! serve_memory1 {
     ($storage:ty, $banks:expr) => {{
+        type Device = co401memory1::Memory1<$storage, co401memory1::FixedBoard>;
+        #[inline(never)]
+        fn mount(banks: [$storage; 2]) -> &'static mut Device {
+            let Ok(device) = co401memory1::Memory1::new(banks, co401memory1::FixedBoard::new(5)) else { panic!("reserved configuration pins") };
+            let Some(device) = cortex_m::singleton!(: Device = device) else { panic!("started twice") };
+            device
+        }
         let Some(core) = cortex_m::Peripherals::take() else { panic!("peripherals taken twice") };
         $crate::clock::start(core.SYST);
-        let Ok(device) = co401memory1::Memory1::new($banks, co401memory1::FixedBoard::new(5)) else { panic!("reserved configuration pins") };
-        let Some(device) = cortex_m::singleton!(: co401memory1::Memory1<$storage, co401memory1::FixedBoard> = device) else {
-            panic!("started twice")
-        };
-        $crate::serve::run(device)
+        $crate::serve::run(mount($banks))
     }};
 }

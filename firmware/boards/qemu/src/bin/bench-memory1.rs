@@ -189,16 +189,21 @@ fn stack_peak() -> usize {
     top - at
 }
 
+/// Builds the module into a `MaybeUninit` static, in a frame of its own: the construction's
+/// temporaries are gone when it returns, instead of staying in `main`'s frame for ever.
+#[inline(never)]
+fn mount(banks: [BorrowedEeprom<'static>; 2]) -> &'static mut Device {
+    let Ok(device) = Memory1::new(banks, FixedBoard::new(NODE_ID)) else { panic!("reserved configuration pins") };
+    let Some(device) = cortex_m::singleton!(: Device = device) else { panic!("mounted twice") };
+    device
+}
+
 #[entry]
 fn main() -> ! {
     static mut BANK1: [u8; BANK_SIZE] = [0; BANK_SIZE];
     static mut BANK2: [u8; BANK_SIZE] = [0; BANK_SIZE];
-    static mut DEVICE: Option<Device> = None;
     paint_stack();
-    let Ok(device) = Memory1::new([BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)], FixedBoard::new(NODE_ID)) else {
-        panic!("reserved configuration pins")
-    };
-    let device = DEVICE.insert(device);
+    let device = mount([BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)]);
 
     // Unmeasured setup. Boot-up, then the EMCYs of the freshly cleared banks (status 0x40).
     device.start(0);
