@@ -47,46 +47,6 @@ fn build_plugin() -> Result<PathBuf> {
     Ok(so)
 }
 
-fn u16_at(b: &[u8], at: usize) -> Option<usize> {
-    Some(usize::from(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?)))
-}
-
-fn u32_at(b: &[u8], at: usize) -> Option<u32> {
-    Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
-}
-
-/// The value of symbol `name` in a little-endian ELF32 file's symbol table (`.symtab`, whose
-/// names are in the string table its `sh_link` names). A few lines of reading instead of a
-/// dependency: `images.rs` reads section headers the same way.
-pub fn symbol(elf: &[u8], name: &str) -> std::result::Result<u32, String> {
-    if elf.get(..6) != Some(&[0x7F, b'E', b'L', b'F', 1, 1][..]) {
-        return Err("not a little-endian ELF32 file".into());
-    }
-    let bad = || "truncated ELF file".to_string();
-    let (shoff, shentsize, shnum) = (u32_at(elf, 32).ok_or_else(bad)? as usize, u16_at(elf, 46).ok_or_else(bad)?, u16_at(elf, 48).ok_or_else(bad)?);
-    // (type, link, offset, size, entsize) of section `i`.
-    let section = |i: usize| -> Option<(u32, u32, usize, usize, usize)> {
-        let at = shoff + i * shentsize;
-        Some((u32_at(elf, at + 4)?, u32_at(elf, at + 24)?, u32_at(elf, at + 16)? as usize, u32_at(elf, at + 20)? as usize, u32_at(elf, at + 36)? as usize))
-    };
-    const SHT_SYMTAB: u32 = 2;
-    for i in 0..shnum {
-        let (kind, link, offset, size, entsize) = section(i).ok_or_else(bad)?;
-        if kind != SHT_SYMTAB || entsize < 16 {
-            continue;
-        }
-        let strtab = section(link as usize).ok_or_else(bad)?.2;
-        for sym in (offset..offset + size).step_by(entsize) {
-            let name_at = strtab + u32_at(elf, sym).ok_or_else(bad)? as usize;
-            let found = elf.get(name_at..).unwrap_or_default();
-            if found.starts_with(name.as_bytes()) && found.get(name.len()) == Some(&0) {
-                return u32_at(elf, sym + 4).ok_or_else(bad);
-            }
-        }
-    }
-    Err(format!("no symbol `{name}` in the symbol table"))
-}
-
 /// What a QEMU run printed, and how it ended.
 struct QemuRun {
     code: Option<i32>,
@@ -326,22 +286,6 @@ fn human_time(ns: f64) -> String {
     }
 }
 
-/// The size report, as `cargo xtask size` prints it. `size::report` prints rather than
-/// returns its table, so the `size` command runs as a child process whose output is captured
-/// (which also keeps this independent of that module's functions). Through `cargo run`, not
-/// this process's own executable: a concurrent build of the workspace may have replaced it.
-fn size_report() -> Result<String> {
-    let mut cmd = cargo();
-    cmd.args(["run", "--quiet", "-p", "xtask", "--", "size"]).current_dir(root());
-    println!("xtask: $ cargo run --quiet -p xtask -- size");
-    let out = cmd.output().map_err(|e| format!("cannot run `xtask size`: {e}"))?;
-    if !out.status.success() {
-        return Err(format!("`xtask size` failed:\n{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr)));
-    }
-    let text = String::from_utf8_lossy(&out.stdout);
-    Ok(text.lines().filter(|l| !l.starts_with("xtask: $")).map(|l| l.strip_prefix("xtask: ").unwrap_or(l)).collect::<Vec<_>>().join("\n"))
-}
-
 /// `cargo xtask bench [--selftest | --instructions]`: the whole report, only the self-test, or
 /// only the instruction counts.
 pub fn main(args: &[String]) -> Result {
@@ -359,7 +303,7 @@ fn instructions() -> Result<String> {
     let plugin = build_plugin()?;
     let elf = build_image()?;
     let bytes = std::fs::read(&elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
-    let marker = |name: &str| symbol(&bytes, name).map_err(|e| format!("{}: {e}", elf.display()));
+    let marker = |name: &str| crate::elf::symbol(&bytes, name).map_err(|e| format!("{}: {e}", elf.display()));
     let (begin, end) = (marker("bench_begin")?, marker("bench_end")?);
     let plugin_arg = format!("{},begin={begin:#x},end={end:#x}", plugin.display());
     let r = qemu(&elf, &["-d".into(), "plugin".into(), "-plugin".into(), plugin_arg])?;
@@ -375,7 +319,7 @@ pub fn report() -> Result {
     println!("xtask: criterion benchmarks ({})", CRITERION_ARGS.join(" "));
     let estimates = criterion()?;
     println!("xtask: size report");
-    let size = size_report()?;
+    let size = crate::size::table()?;
 
     let mut md = String::from("# coforge benchmarks\n\n## CO401Memory1 on a Cortex-M3 (QEMU lm3s6965evb, instructions executed)\n\n");
     md.push_str(&format!(
@@ -387,7 +331,7 @@ pub fn report() -> Result {
     for (id, ns) in &estimates {
         md.push_str(&format!("| {id} | {} |\n", human_time(*ns)));
     }
-    md.push_str(&format!("\n## Size (`cargo xtask size`)\n\n```text\n{size}\n```\n"));
+    md.push_str(&format!("\n## Size (`cargo xtask size`)\n\n```text\n{}\n```\n", size.trim_end()));
     let path = out_dir().join("report.md");
     crate::write(&path, &md)?;
     println!("\n{table}");

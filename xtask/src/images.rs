@@ -1,6 +1,7 @@
 //! Firmware images: each board crate's binaries, built for the board's target and copied to
 //! `target/dist/images/<device>-<board>.elf` with a raw `.bin` for flashing.
 
+use crate::elf::{self, Section};
 use crate::{Result, cargo, root, run};
 use std::path::PathBuf;
 
@@ -141,45 +142,19 @@ fn overflow(linker: &str) -> Option<(String, u64)> {
         .max_by_key(|(_, n)| *n)
 }
 
-fn u16_at(b: &[u8], at: usize) -> Option<u16> {
-    Some(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?))
-}
-
-fn u32_at(b: &[u8], at: usize) -> Option<u32> {
-    Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
-}
-
 /// Checks an image against its chip's memory map: the vector table at the start of flash, its
 /// initial stack pointer inside RAM, its reset vector the ELF entry point (a Thumb address),
 /// code and constants in flash, variables in RAM.
 pub fn check_memory_map(elf: &[u8], flash: (u32, u32), ram: (u32, u32)) -> std::result::Result<(), String> {
     let inside = |(origin, len): (u32, u32), addr: u32, size: u32| addr >= origin && u64::from(addr) + u64::from(size) <= u64::from(origin) + u64::from(len);
-    let bad = || "truncated ELF header".to_string();
-    let entry = u32_at(elf, 24).ok_or_else(bad)?;
-    let (shoff, shentsize, shnum, shstrndx) = (
-        u32_at(elf, 32).ok_or_else(bad)? as usize,
-        u16_at(elf, 46).ok_or_else(bad)? as usize,
-        u16_at(elf, 48).ok_or_else(bad)?,
-        u16_at(elf, 50).ok_or_else(bad)?,
-    );
-    let section = |i: usize| -> Option<(u32, u32, u32, u32, u32)> {
-        let at = shoff + i * shentsize;
-        Some((u32_at(elf, at)?, u32_at(elf, at + 8)?, u32_at(elf, at + 12)?, u32_at(elf, at + 16)?, u32_at(elf, at + 20)?))
-    };
-    let strtab = section(usize::from(shstrndx)).ok_or("no section name table")?.3 as usize;
-    let name = |off: u32| -> String {
-        let start = strtab + off as usize;
-        let bytes = elf.get(start..).unwrap_or_default();
-        String::from_utf8_lossy(&bytes[..bytes.iter().position(|&b| b == 0).unwrap_or(0)]).into_owned()
-    };
+    let entry = elf::field(elf, 24)?;
     let mut vectors = None;
-    for i in 0..usize::from(shnum) {
-        let (name_off, flags, addr, offset, size) = section(i).ok_or_else(|| format!("truncated section header {i}"))?;
-        const ALLOC: u32 = 0x2;
-        if flags & ALLOC == 0 || size == 0 {
+    for section in elf::sections(elf)? {
+        let Section { name, addr, offset, size, .. } = &section;
+        let (addr, offset, size) = (*addr, *offset, *size);
+        if !section.allocated() || size == 0 {
             continue;
         }
-        let name = name(name_off);
         let (region, what) = match name.as_str() {
             ".vector_table" | ".text" | ".rodata" => (flash, "flash"),
             ".data" | ".bss" | ".uninit" => (ram, "RAM"),
@@ -190,14 +165,14 @@ pub fn check_memory_map(elf: &[u8], flash: (u32, u32), ram: (u32, u32)) -> std::
             return Err(format!("section {name} at {addr:#010x}..{:#010x} is outside {what}", u64::from(addr) + u64::from(size)));
         }
         if name == ".vector_table" {
-            vectors = Some((addr, offset as usize));
+            vectors = Some((addr, offset));
         }
     }
     let (addr, offset) = vectors.ok_or("no .vector_table section")?;
     if addr != flash.0 {
         return Err(format!("the vector table is at {addr:#010x}, not at the start of flash {:#010x}", flash.0));
     }
-    let (sp, reset) = (u32_at(elf, offset).ok_or_else(bad)?, u32_at(elf, offset + 4).ok_or_else(bad)?);
+    let (sp, reset) = (elf::field(elf, offset)?, elf::field(elf, offset + 4)?);
     if !(sp > ram.0 && u64::from(sp) <= u64::from(ram.0) + u64::from(ram.1)) {
         return Err(format!("initial stack pointer {sp:#010x} is outside RAM"));
     }
@@ -211,15 +186,13 @@ pub fn check_memory_map(elf: &[u8], flash: (u32, u32), ram: (u32, u32)) -> std::
 /// little-endian ELF32, placed at their physical (load) addresses from the lowest one, gaps
 /// filled with 0xFF (erased flash).
 pub fn raw_binary(elf: &[u8]) -> std::result::Result<Vec<u8>, String> {
-    if elf.get(..6) != Some(&[0x7F, b'E', b'L', b'F', 1, 1][..]) {
-        return Err("not a little-endian ELF32 file".into());
-    }
+    elf::check_header(elf)?;
     let bad = || "truncated ELF header".to_string();
-    let (phoff, phentsize, phnum) = (u32_at(elf, 28).ok_or_else(bad)? as usize, u16_at(elf, 42).ok_or_else(bad)? as usize, u16_at(elf, 44).ok_or_else(bad)?);
+    let (phoff, phentsize, phnum) = (elf::field(elf, 28)? as usize, usize::from(elf::u16_at(elf, 42).ok_or_else(bad)?), elf::u16_at(elf, 44).ok_or_else(bad)?);
     let mut segments = Vec::new();
     for i in 0..usize::from(phnum) {
         let ph = phoff + i * phentsize;
-        let field = |n: usize| u32_at(elf, ph + 4 * n).ok_or_else(|| format!("truncated program header {i}"));
+        let field = |n: usize| elf::u32_at(elf, ph + 4 * n).ok_or_else(|| format!("truncated program header {i}"));
         let (kind, offset, paddr, filesz) = (field(0)?, field(1)? as usize, field(3)?, field(4)? as usize);
         if kind == 1 && filesz > 0 {
             let data = elf.get(offset..offset + filesz).ok_or_else(|| format!("segment {i} outside the file"))?;
@@ -269,32 +242,23 @@ mod tests {
         f
     }
 
-    /// The image `cargo xtask dist` built, when there is one (the suite builds it before).
+    /// Every image `cargo xtask dist` built (the suite builds them before), on every board:
+    /// the QEMU lm3s6965 and the STM32F042K6.
     #[test]
-    fn the_built_qemu_image_fits_the_lm3s6965_memory_map() {
-        let board = &super::BOARDS[0];
-        let elf = super::built_elf(board, "co401memory1");
-        let Ok(bytes) = std::fs::read(&elf) else {
-            panic!("{} is missing: run `cargo xtask dist` first", elf.display());
-        };
-        super::check_memory_map(&bytes, board.flash, board.ram).unwrap();
-        // The same image against a chip whose flash is elsewhere, or whose RAM is smaller.
-        assert!(super::check_memory_map(&bytes, (0x0800_0000, 256 * 1024), board.ram).is_err());
-        assert!(super::check_memory_map(&bytes, board.flash, (0x2000_0000, 1024)).is_err());
-    }
-
-    /// The STM32F042K6 image `cargo xtask dist` built.
-    #[test]
-    fn the_built_stm32f0_image_fits_the_stm32f042k6_memory_map() {
-        let board = &super::STM32F0;
-        let elf = super::built_elf(board, "co401memory1");
-        let Ok(bytes) = std::fs::read(&elf) else {
-            panic!("{} is missing: run `cargo xtask dist` first", elf.display());
-        };
-        super::check_memory_map(&bytes, board.flash, board.ram).unwrap();
-        // The same image against a chip whose flash starts at 0, or whose RAM is smaller.
-        assert!(super::check_memory_map(&bytes, (0, 32 * 1024), board.ram).is_err());
-        assert!(super::check_memory_map(&bytes, board.flash, (0x2000_0000, 1024)).is_err());
+    fn every_built_image_fits_its_chips_memory_map() {
+        for board in super::BOARDS {
+            for device in board.devices {
+                let elf = super::built_elf(board, device);
+                let Ok(bytes) = std::fs::read(&elf) else {
+                    panic!("{} is missing: run `cargo xtask dist` first", elf.display());
+                };
+                super::check_memory_map(&bytes, board.flash, board.ram).unwrap();
+                // The same image against a chip whose flash is elsewhere, or whose RAM is smaller.
+                let elsewhere = (board.flash.0 ^ 0x0800_0000, board.flash.1);
+                assert!(super::check_memory_map(&bytes, elsewhere, board.ram).is_err(), "{device} on {}", board.name);
+                assert!(super::check_memory_map(&bytes, board.flash, (0x2000_0000, 1024)).is_err(), "{device} on {}", board.name);
+            }
+        }
     }
 
     #[test]

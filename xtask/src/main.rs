@@ -5,6 +5,7 @@
 #![forbid(unsafe_code)]
 
 mod bench;
+mod elf;
 mod images;
 mod setup;
 mod size;
