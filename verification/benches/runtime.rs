@@ -3,7 +3,7 @@
 //! byte). Cortex-M instruction counts come with the board images.
 
 use coforge_link::{Deframer, Frame};
-use coforge_stack::od::{AccessContext, NmtState, NoAppObjects, ObjectDictionary, Side};
+use coforge_stack::od::{AccessContext, EntryAccess, NmtState, NoAppObjects, Side};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 

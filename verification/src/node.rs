@@ -106,7 +106,9 @@ trait Driven {
     fn read_device(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Option<usize>;
 }
 
-impl<D: coforge_stack::od::Dictionary, S: coforge_stack::store::ParamStore, const N: usize, const P: usize> Driven for coforge_stack::node::Node<D, S, N, P> {
+impl<D: coforge_stack::od::NodeDictionary, S: coforge_stack::store::ParamStore, const N: usize, const P: usize> Driven
+    for coforge_stack::node::Node<D, S, N, P>
+{
     fn start(&mut self, now: u64) {
         coforge_stack::node::Node::start(self, now);
     }

@@ -2,7 +2,7 @@
 //! resolved, access per side and NMT state, abort codes, app-backed routing, modes; and every
 //! entry of every device can be read and written back through the generated dispatch.
 
-use coforge_stack::od::{AccessContext, AppObjects, EntryInfo, NmtState, ObjectDictionary, ReadLen, SdoAbort, Side, read_slice};
+use coforge_stack::od::{AccessContext, AppObjects, EntryAccess, EntryInfo, NmtState, ReadLen, SdoAbort, Side, read_slice};
 
 /// App-backed storage for tests: one byte per (index, sub), like CO401Memory1's banks.
 #[derive(Debug, Clone)]
@@ -26,13 +26,13 @@ fn memory() -> Memory {
 const PREOP: AccessContext = AccessContext { nmt: NmtState::PreOperational, can_enabled: false };
 const OP: AccessContext = AccessContext { nmt: NmtState::Operational, can_enabled: true };
 
-fn read(od: &mut impl ObjectDictionary, index: u16, sub: u8, side: Side) -> Result<Vec<u8>, SdoAbort> {
+fn read(od: &mut impl EntryAccess, index: u16, sub: u8, side: Side) -> Result<Vec<u8>, SdoAbort> {
     let mut buf = [0_u8; 64];
     od.read(index, sub, 0, &mut buf, side).map(|n| buf[..n.copied].to_vec())
 }
 
 /// Reads every entry as the device and writes the value back: every dispatch arm runs.
-fn sweep(od: &mut impl ObjectDictionary, table: &[EntryInfo]) -> usize {
+fn sweep(od: &mut impl EntryAccess, table: &[EntryInfo]) -> usize {
     let mut n = 0;
     for run in table {
         for index in run.index..=run.index + u16::from(run.copies) {
@@ -119,8 +119,8 @@ fn cr3101_and_canopenia_dictionaries_sweep() {
 #[test]
 fn co401gw1_persistent_block_saves_loads_and_restores() {
     use co401gw1::{Mode, Od};
-    use coforge_stack::od::{Area, Dictionary};
-    let size = <Od<Memory> as Dictionary>::PERSISTENT_SIZE;
+    use coforge_stack::od::{Area, NodeDictionary};
+    let size = <Od<Memory> as NodeDictionary>::PERSISTENT_SIZE;
     let mut a = Od::new(Mode::Mixed, 5, memory());
     assert_eq!(a.write(0x100C, 0, &[0xF4, 0x01], Side::Bus, &PREOP), Ok(()));
     assert_eq!(a.write(0x1800, 1, &[0x85, 0x03, 0, 0], Side::Bus, &PREOP), Ok(()), "TPDO1 COB-ID is persistent");
@@ -149,5 +149,5 @@ fn co401gw1_persistent_block_saves_loads_and_restores() {
     b.reset_area(Area::COMMUNICATION, 7);
     assert_eq!(b.guard_time, 0);
     assert_eq!(read(&mut b, 0x1800, 1, Side::Bus), Ok(vec![0x87, 0x01, 0, 0]), "defaults with $NODEID for node 7");
-    const { assert!(<Od<Memory> as Dictionary>::PERSISTENT_SIZE > 40) };
+    const { assert!(<Od<Memory> as NodeDictionary>::PERSISTENT_SIZE > 40) };
 }

@@ -2,7 +2,7 @@
 //! a corrupt or torn block is ignored so the node keeps the spec defaults.
 
 use co401gw1::{Mode, Od};
-use coforge_stack::od::{AccessContext, Area, NmtState, NoAppObjects, ObjectDictionary, Side};
+use coforge_stack::od::{AccessContext, Area, EntryAccess, NmtState, NoAppObjects, Side};
 use coforge_stack::store::{BlockStore, ParamStore};
 use coforge_verification::node::RamStorage;
 
@@ -32,7 +32,7 @@ fn a_saved_block_loads_back() {
 
 #[test]
 fn every_corrupted_byte_falls_back_to_defaults() {
-    let len = 12 + <Od<NoAppObjects> as coforge_stack::od::Dictionary>::PERSISTENT_SIZE;
+    let len = 12 + <Od<NoAppObjects> as coforge_stack::od::NodeDictionary>::PERSISTENT_SIZE;
     for at in 0..len {
         let mut image = saved_block().into_inner();
         // Every byte of header (magic, length, CRC, reserved) and data.

@@ -1,6 +1,6 @@
 //! The typed dictionary: `Od<A>` with one field per RAM/persistent object (app-backed entries
 //! go to `A: AppObjects`), `Od::new` with the spec's defaults (`$NODEID` resolved), and the
-//! `ObjectDictionary` implementation: `field` is one generated `match` on the entry's dense
+//! `EntryAccess` implementation: `field` is one generated `match` on the entry's dense
 //! object number, so reads and writes share one jump table and their code lives in the stack.
 
 use crate::Options;
@@ -275,7 +275,7 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
             /// The dictionary with the spec's defaults, `$NODEID` resolved for `node_id`: all
             /// zero first, then the one place that knows the defaults, `reset_area`.
             pub fn new(mode: Mode, node_id: u8, app: A) -> Self {
-                use #stack::od::Dictionary as _;
+                use #stack::od::NodeDictionary as _;
                 let mut od = Od { mode, app, #(#names: Default::default()),* };
                 od.reset_area(#stack::od::Area::ALL, node_id);
                 od
@@ -286,7 +286,7 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
             }
         }
 
-        impl<A: #stack::od::AppObjects> #stack::od::Dictionary for Od<A> {
+        impl<A: #stack::od::AppObjects> #stack::od::NodeDictionary for Od<A> {
             const PERSISTENT_SIZE: usize = 0 #(+ <#types as #stack::value::Persist>::SIZE)*;
             const SDO_BLOCK_TRANSFER: bool = #block_transfer;
             const COMM: #stack::od::CommObjects =
@@ -335,7 +335,7 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
             }
         }
 
-        impl<A: #stack::od::AppObjects> #stack::od::ObjectDictionary for Od<A> {
+        impl<A: #stack::od::AppObjects> #stack::od::EntryAccess for Od<A> {
             type App = A;
 
             fn entries(&self) -> &'static [#stack::od::EntryInfo] {

@@ -8,7 +8,7 @@
 //!   runs, value limits in shared statics;
 //! - `pdo::rpdos(mode)` / `pdo::tpdos(mode)`: the default PDOs, with compile-time checks that
 //!   every mapping fits a CAN frame;
-//! - `Od<A>`: the typed dictionary and its `ObjectDictionary`/`Dictionary` dispatch;
+//! - `Od<A>`: the typed dictionary and its `EntryAccess`/`NodeDictionary` dispatch;
 //! - `emcy::*`: the spec's emergencies; `serial::*`: the host protocol's codecs;
 //! - `hardware::*`: decoders of the configuration pins (node-ID, bit rates, configuration);
 //! - identity constants and the `Node<A, S>` alias.

@@ -5,7 +5,7 @@ use crate::storage::MemStorage;
 use coforge_stack::emcy::EmcyDefault;
 use coforge_stack::frame::CanFrame;
 use coforge_stack::node::{BusState, Node, NodeEvent};
-use coforge_stack::od::{Dictionary, ReadLen, SdoAbort, Side};
+use coforge_stack::od::{NodeDictionary, ReadLen, SdoAbort, Side};
 use coforge_stack::store::{BlockStore, ParamStore};
 use std::path::PathBuf;
 
@@ -44,7 +44,7 @@ pub trait SimNode: Send {
 
 impl<D, S, const N: usize, const P: usize> SimNode for Node<D, S, N, P>
 where
-    D: Dictionary + Send,
+    D: NodeDictionary + Send,
     S: ParamStore + Send,
 {
     fn start(&mut self, now_us: u64) {
@@ -135,7 +135,7 @@ macro_rules! device_kind {
                         format!("{} has no mode `{name}`; its modes are: {}", stringify!($krate), known.join(", "))
                     })?,
                 };
-                let size = <$krate::Od<RamApp> as Dictionary>::PERSISTENT_SIZE;
+                let size = <$krate::Od<RamApp> as NodeDictionary>::PERSISTENT_SIZE;
                 let storage = eeprom(store, BlockStore::<MemStorage>::capacity_for(size), "")?;
                 let od = $krate::Od::new(mode, node_id, RamApp::default());
                 let node: $krate::Node<RamApp, BlockStore<MemStorage>> = Node::new(od, BlockStore::new(storage, 0), $krate::node_config(node_id));

@@ -2,13 +2,13 @@
 //! emulation, a file on a PC).
 //!
 //! Two slots alternate, each a header (magic "CFG1", block length u32 LE, CRC-16/XMODEM u16
-//! LE, sequence number u16 LE) and the data as [`Dictionary::save_area`] lays it out. The CRC
+//! LE, sequence number u16 LE) and the data as [`NodeDictionary::save_area`] lays it out. The CRC
 //! covers length, sequence and data. A save writes the slot that does not hold the newest
 //! valid block, and its header last, so a save torn by a reset or a storage error leaves the
 //! previous block in place. A slot whose magic, length or CRC does not match is ignored; with
 //! no valid slot the node keeps the spec defaults instead of loading garbage.
 
-use crate::od::{Area, Dictionary};
+use crate::od::{Area, NodeDictionary};
 use coforge_link::crc::{Crc16, XMODEM};
 use embedded_storage::Storage;
 
@@ -35,22 +35,22 @@ pub trait ParamStore {
     fn erase(&mut self, od: &dyn DictionaryImage) -> Result<(), StoreError>;
 }
 
-/// The object-safe part of [`Dictionary`] that storing needs.
+/// The object-safe part of [`NodeDictionary`] that storing needs.
 pub trait DictionaryImage {
     fn size(&self) -> usize;
     fn save_area(&self, area: Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool;
     fn load_area(&mut self, area: Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool;
 }
 
-impl<D: Dictionary> DictionaryImage for D {
+impl<D: NodeDictionary> DictionaryImage for D {
     fn size(&self) -> usize {
         D::PERSISTENT_SIZE
     }
     fn save_area(&self, area: Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-        Dictionary::save_area(self, area, sink)
+        NodeDictionary::save_area(self, area, sink)
     }
     fn load_area(&mut self, area: Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-        Dictionary::load_area(self, area, source)
+        NodeDictionary::load_area(self, area, source)
     }
 }
 

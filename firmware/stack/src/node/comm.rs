@@ -13,12 +13,12 @@
 use super::Core;
 use super::le_u32;
 use crate::heartbeat::{Consumer, MAX_CONSUMED};
-use crate::od::{Dictionary, SdoAbort, Side};
+use crate::od::{NodeDictionary, SdoAbort, Side};
 use crate::pdo::slot::mapping_words;
 use crate::pdo::{COB_EXTENDED, COB_INVALID, Dir, Mapping, mapping::check_entry, restricted_cob_id};
 use crate::store::ParamStore;
 
-impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     pub(super) fn check_communication(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
         // Values of the wrong length are the dictionary's to refuse.
         let value = le_u32(data);

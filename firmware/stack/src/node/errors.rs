@@ -5,10 +5,10 @@ use super::{BusState, Core, NodeEvent, read_u32};
 use crate::emcy::{EmcyDefault, EmcyEvent, Reaction};
 use crate::leds::{LedState, Leds};
 use crate::nmt::{self, NmtState};
-use crate::od::{Dictionary, Side};
+use crate::od::{NodeDictionary, Side};
 use crate::store::ParamStore;
 
-impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     /// The next queued emergency, if the state and the inhibit time allow it now.
     pub(super) fn send_emcy(&mut self) {
         if nmt::allows_emcy_and_sync(self.state)

@@ -27,14 +27,14 @@ use crate::guarding::{GuardEvent, Guarding};
 use crate::heartbeat::{Consumer, ConsumerEvent, Producer};
 use crate::leds::Leds;
 use crate::nmt::{self, NmtCommand, NmtState};
-use crate::od::{AccessContext, Area, Dictionary, ObjectDictionary, SdoAbort, Side};
+use crate::od::{AccessContext, Area, EntryAccess, NodeDictionary, SdoAbort, Side};
 use crate::pdo::{Rpdo, Tpdo};
 use crate::sdo::SdoServer;
 use crate::store::ParamStore;
 use heapless::{Deque, Vec};
 
 /// Reads an integer entry (up to 4 bytes, little-endian) without access checks.
-pub fn read_u32(od: &mut impl ObjectDictionary, index: u16, sub: u8) -> Option<u32> {
+pub fn read_u32(od: &mut impl EntryAccess, index: u16, sub: u8) -> Option<u32> {
     let mut buf = [0_u8; 4];
     let n = od.read(index, sub, 0, &mut buf, Side::Device).ok()?.copied;
     Some(le_u32(buf.get(..n).unwrap_or(&buf)))
@@ -158,7 +158,7 @@ pub struct Node<D, S, const N: usize, const P: usize> {
     sdo: SdoServer<N>,
 }
 
-impl<D: Dictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N, P> {
+impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N, P> {
     /// A node that has not booted yet; call [`Node::start`].
     pub fn new(od: D, store: S, cfg: NodeConfig) -> Self {
         let mut sdo = SdoServer::new();
@@ -350,7 +350,7 @@ impl<D: Dictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N,
     }
 }
 
-impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     fn ctx(&self) -> AccessContext {
         AccessContext { nmt: self.state, can_enabled: true }
     }

@@ -6,12 +6,12 @@ use super::{Core, read_u32};
 use crate::emcy::EmcyEvent;
 use crate::heartbeat::Consumer;
 use crate::nmt;
-use crate::od::Dictionary;
+use crate::od::NodeDictionary;
 use crate::pdo::{Dir, Rpdo, Tpdo};
 use crate::store::ParamStore;
 use heapless::Vec;
 
-impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     pub(super) fn on_guard_request(&mut self, now_us: u64) {
         // CiA 301: a node with a heartbeat producer time does not answer guarding.
         if self.heartbeat.period_ms() != 0 {

@@ -3,11 +3,11 @@
 
 use super::{Core, NodeEvent};
 use crate::emcy::EmcyEvent;
-use crate::od::Dictionary;
+use crate::od::NodeDictionary;
 use crate::pdo::Rpdo;
 use crate::store::ParamStore;
 
-impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     pub(super) fn on_rpdo(&mut self, i: usize, data: &[u8]) {
         let Some(r) = self.rpdos.get(i).copied() else { return };
         if data.len() < usize::from(r.mapping.len()) || r.mapping.is_empty() {

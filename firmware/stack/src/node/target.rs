@@ -1,12 +1,12 @@
 //! Writes with their side effects, and the SDO server's view of the node.
 
 use super::{Core, read_u32};
-use crate::od::{Dictionary, ReadLen, SdoAbort, Side, Storage};
+use crate::od::{NodeDictionary, ReadLen, SdoAbort, Side, Storage};
 use crate::pdo::Dir;
 use crate::sdo::SdoTarget;
 use crate::store::ParamStore;
 
-impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     /// A write from any side: the communication-object rules first, then the dictionary's
     /// own checks, then whatever the new value changes.
     pub(super) fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
@@ -96,7 +96,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     }
 }
 
-impl<D: Dictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, P> {
+impl<D: NodeDictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, P> {
     const BLOCK_TRANSFER: bool = D::SDO_BLOCK_TRANSFER;
 
     fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
@@ -123,7 +123,7 @@ impl<D: Dictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, P> {
     }
 }
 
-impl<D: Dictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     pub(super) fn current(&mut self, index: u16, sub: u8) -> u32 {
         read_u32(&mut self.od, index, sub).unwrap_or(0)
     }

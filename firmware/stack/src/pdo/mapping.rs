@@ -2,7 +2,7 @@
 //! mapped values into a frame.
 
 use super::Dir;
-use crate::od::{DataType, EntryInfo, ObjectDictionary, SdoAbort, find_run};
+use crate::od::{DataType, EntryAccess, EntryInfo, SdoAbort, find_run};
 
 /// Most entries a PDO maps (one per byte of a CAN frame).
 pub const MAX_MAPPED: usize = 8;
@@ -11,7 +11,7 @@ pub const MAX_MAPPED: usize = 8;
 /// table, so sending and receiving a PDO needs no lookup.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Mapped {
-    /// Position in [`ObjectDictionary::entries`], or [`DUMMY`].
+    /// Position in [`EntryAccess::entries`], or [`DUMMY`].
     pub run: u16,
     pub sub: u8,
     /// Bits 0..=2: bytes - 1; bits 3..=7: which copy of the run's object is mapped (see
@@ -68,7 +68,7 @@ const fn dummy_bytes(index: u16) -> Option<u8> {
 
 /// Checks one mapping entry against the dictionary (CiA 301 7.5.2.36): the object exists,
 /// may be mapped in this direction, and the length fits its type.
-pub fn check_entry(od: &impl ObjectDictionary, word: u32, dir: Dir) -> Result<Mapped, SdoAbort> {
+pub fn check_entry(od: &impl EntryAccess, word: u32, dir: Dir) -> Result<Mapped, SdoAbort> {
     let (index, sub, bits) = Mapped::decode(word);
     if bits == 0 || bits % 8 != 0 {
         // Only byte-aligned mapping is supported.
@@ -110,7 +110,7 @@ pub struct Mapping {
 
 impl Mapping {
     /// Checks a whole mapping: every entry, and at most 64 bits in total.
-    pub fn check(od: &impl ObjectDictionary, words: &[u32], dir: Dir) -> Result<Mapping, SdoAbort> {
+    pub fn check(od: &impl EntryAccess, words: &[u32], dir: Dir) -> Result<Mapping, SdoAbort> {
         let mut m = Mapping::default();
         for &w in words {
             let e = check_entry(od, w, dir)?;
@@ -144,7 +144,7 @@ impl Mapping {
     }
 
     /// Reads the mapped values into a frame payload; returns its length.
-    pub fn pack(&self, od: &mut impl ObjectDictionary, out: &mut [u8; 8]) -> Result<usize, SdoAbort> {
+    pub fn pack(&self, od: &mut impl EntryAccess, out: &mut [u8; 8]) -> Result<usize, SdoAbort> {
         let entries = od.entries();
         let mut at = 0;
         for e in self.entries() {

@@ -2,7 +2,7 @@
 //! mapping, and the timers and buffers its transmission type needs.
 
 use super::{COB_EXTENDED, COB_INVALID, COB_NO_RTR, Dir, Mapping};
-use crate::od::{ObjectDictionary, SdoAbort};
+use crate::od::{EntryAccess, SdoAbort};
 
 /// Communication parameters as read from 14xxh/18xxh.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -20,7 +20,7 @@ pub struct Comm {
 impl Comm {
     /// Reads the parameters of the PDO whose communication object is `index`; sub-entries
     /// the spec leaves out read as 0.
-    pub fn read(od: &mut impl ObjectDictionary, index: u16) -> Comm {
+    pub fn read(od: &mut impl EntryAccess, index: u16) -> Comm {
         let int = |od: &mut _, sub| crate::node::read_u32(od, index, sub).unwrap_or(0);
         Comm {
             cob_id: int(od, 1),
@@ -57,7 +57,7 @@ impl Comm {
 
 /// The first `count` entries (subs 1..=count) of mapping object `index`: `PdoTooLong` if
 /// more than a frame can carry, `InvalidValue` if the object has fewer sub-indices.
-pub fn mapping_words(od: &mut impl ObjectDictionary, index: u16, count: u32) -> Result<([u32; 8], usize), SdoAbort> {
+pub fn mapping_words(od: &mut impl EntryAccess, index: u16, count: u32) -> Result<([u32; 8], usize), SdoAbort> {
     let mut words = [0_u32; 8];
     let count = usize::try_from(count).unwrap_or(usize::MAX);
     if count > words.len() {
@@ -72,7 +72,7 @@ pub fn mapping_words(od: &mut impl ObjectDictionary, index: u16, count: u32) -> 
 
 /// Reads a mapping object (sub 0 = count, subs 1..=count the entries) and checks it; an
 /// invalid stored mapping counts as empty.
-pub fn read_mapping(od: &mut impl ObjectDictionary, index: u16, dir: Dir) -> Mapping {
+pub fn read_mapping(od: &mut impl EntryAccess, index: u16, dir: Dir) -> Mapping {
     let count = crate::node::read_u32(od, index, 0).unwrap_or(0);
     mapping_words(od, index, count).and_then(|(words, n)| Mapping::check(od, words.get(..n).unwrap_or(&[]), dir)).unwrap_or_default()
 }
@@ -94,7 +94,7 @@ pub struct Rpdo {
 }
 
 impl Rpdo {
-    pub fn load(od: &mut impl ObjectDictionary, offset: u16) -> Rpdo {
+    pub fn load(od: &mut impl EntryAccess, offset: u16) -> Rpdo {
         let index = Dir::Rx.comm_base() + offset;
         Rpdo {
             offset,
@@ -149,7 +149,7 @@ pub struct Tpdo {
 }
 
 impl Tpdo {
-    pub fn load(od: &mut impl ObjectDictionary, offset: u16, now_us: u64) -> Tpdo {
+    pub fn load(od: &mut impl EntryAccess, offset: u16, now_us: u64) -> Tpdo {
         let index = Dir::Tx.comm_base() + offset;
         let comm = Comm::read(od, index);
         let mut t = Tpdo {

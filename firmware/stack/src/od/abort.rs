@@ -1,0 +1,109 @@
+//! CiA 301 SDO abort codes: the one answer every refused access gets.
+
+/// CiA 301 SDO abort codes (table 22).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum SdoAbort {
+    ToggleBit = 0x0503_0000,
+    Timeout = 0x0504_0000,
+    UnknownCommand = 0x0504_0001,
+    InvalidBlockSize = 0x0504_0002,
+    InvalidSequence = 0x0504_0003,
+    BlockCrc = 0x0504_0004,
+    OutOfMemory = 0x0504_0005,
+    UnsupportedAccess = 0x0601_0000,
+    WriteOnly = 0x0601_0001,
+    ReadOnly = 0x0601_0002,
+    NoObject = 0x0602_0000,
+    NotMappable = 0x0604_0041,
+    PdoTooLong = 0x0604_0042,
+    IncompatibleParameter = 0x0604_0043,
+    IncompatibleInternal = 0x0604_0047,
+    Hardware = 0x0606_0000,
+    LengthMismatch = 0x0607_0010,
+    LengthTooHigh = 0x0607_0012,
+    LengthTooLow = 0x0607_0013,
+    NoSubIndex = 0x0609_0011,
+    InvalidValue = 0x0609_0030,
+    ValueTooHigh = 0x0609_0031,
+    ValueTooLow = 0x0609_0032,
+    MaxBelowMin = 0x0609_0036,
+    NoResource = 0x060A_0023,
+    General = 0x0800_0000,
+    DataTransfer = 0x0800_0020,
+    DataTransferLocal = 0x0800_0021,
+    DataTransferState = 0x0800_0022,
+    NoDictionary = 0x0800_0023,
+    NoData = 0x0800_0024,
+}
+
+impl SdoAbort {
+    pub const ALL: [SdoAbort; 31] = [
+        SdoAbort::ToggleBit,
+        SdoAbort::Timeout,
+        SdoAbort::UnknownCommand,
+        SdoAbort::InvalidBlockSize,
+        SdoAbort::InvalidSequence,
+        SdoAbort::BlockCrc,
+        SdoAbort::OutOfMemory,
+        SdoAbort::UnsupportedAccess,
+        SdoAbort::WriteOnly,
+        SdoAbort::ReadOnly,
+        SdoAbort::NoObject,
+        SdoAbort::NotMappable,
+        SdoAbort::PdoTooLong,
+        SdoAbort::IncompatibleParameter,
+        SdoAbort::IncompatibleInternal,
+        SdoAbort::Hardware,
+        SdoAbort::LengthMismatch,
+        SdoAbort::LengthTooHigh,
+        SdoAbort::LengthTooLow,
+        SdoAbort::NoSubIndex,
+        SdoAbort::InvalidValue,
+        SdoAbort::ValueTooHigh,
+        SdoAbort::ValueTooLow,
+        SdoAbort::MaxBelowMin,
+        SdoAbort::NoResource,
+        SdoAbort::General,
+        SdoAbort::DataTransfer,
+        SdoAbort::DataTransferLocal,
+        SdoAbort::DataTransferState,
+        SdoAbort::NoDictionary,
+        SdoAbort::NoData,
+    ];
+
+    /// The 32-bit code sent in an SDO abort frame.
+    pub const fn code(self) -> u32 {
+        self as u32
+    }
+
+    pub fn from_code(code: u32) -> Option<SdoAbort> {
+        SdoAbort::ALL.into_iter().find(|a| a.code() == code)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn abort_codes_are_the_cia_301_values() {
+        assert_eq!(SdoAbort::WriteOnly.code(), 0x0601_0001);
+        assert_eq!(SdoAbort::ReadOnly.code(), 0x0601_0002);
+        assert_eq!(SdoAbort::NoObject.code(), 0x0602_0000);
+        assert_eq!(SdoAbort::NoSubIndex.code(), 0x0609_0011);
+        assert_eq!(SdoAbort::LengthMismatch.code(), 0x0607_0010);
+        assert_eq!(SdoAbort::LengthTooHigh.code(), 0x0607_0012);
+        assert_eq!(SdoAbort::LengthTooLow.code(), 0x0607_0013);
+        assert_eq!(SdoAbort::InvalidValue.code(), 0x0609_0030);
+        assert_eq!(SdoAbort::ValueTooHigh.code(), 0x0609_0031);
+        assert_eq!(SdoAbort::ValueTooLow.code(), 0x0609_0032);
+        assert_eq!(SdoAbort::NotMappable.code(), 0x0604_0041);
+        assert_eq!(SdoAbort::DataTransfer.code(), 0x0800_0020);
+        assert_eq!(SdoAbort::DataTransferState.code(), 0x0800_0022);
+        for a in SdoAbort::ALL {
+            assert_eq!(SdoAbort::from_code(a.code()), Some(a));
+        }
+        assert_eq!(SdoAbort::from_code(0x1234_5678), None);
+    }
+}

@@ -1,0 +1,167 @@
+//! The traits generated dictionaries implement: entry access (`EntryAccess`), what a node
+//! needs beyond it (`NodeDictionary`), and the owner of app-backed objects (`AppObjects`).
+
+use super::{AccessContext, EntryInfo, ReadLen, SdoAbort, Side, find};
+use crate::value::OdValue;
+use coforge_types::Storage;
+
+/// The dictionary of one device: implemented by the code `device!` generates.
+///
+/// The generated code provides the table and the field of each stored entry (`field`);
+/// reads, writes, lookups and access checks are the provided methods, so every device
+/// refuses the same accesses with the same codes and the dispatch code exists once.
+pub trait EntryAccess {
+    /// Where app-backed entries (`storage: app`) are read and written.
+    type App: AppObjects;
+
+    /// Every entry description, sorted by index and sub-index (see [`find`]).
+    fn entries(&self) -> &'static [EntryInfo];
+
+    /// The field that stores `sub` of the entry `info` describes, `info` being the run
+    /// [`find_run`] gave for it (so `info.covers(sub)`; single-entry objects do not look at
+    /// `sub` again); `None` for an entry the dictionary does not store (app-backed ones).
+    fn field(&mut self, info: &EntryInfo, sub: u8) -> Option<&mut dyn OdValue>;
+
+    /// The device's app-backed objects.
+    fn app(&mut self) -> &mut Self::App;
+
+    /// Reads the value of `index`/`sub`, which `info` describes, from byte `offset` into
+    /// `buf`: no lookup and no access check (the caller made both).
+    fn read_entry(&mut self, info: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        if info.storage == Storage::App {
+            return self.app().read(info, index, sub, offset, buf);
+        }
+        self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.read(info, offset, buf)
+    }
+
+    /// Writes `data` (the whole value, little-endian) after its length and value checks; no
+    /// lookup and no access check. A refused write leaves the stored value unchanged.
+    fn write_entry(&mut self, info: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        info.check_data(data)?;
+        if info.storage == Storage::App {
+            return self.app().write(info, index, sub, data);
+        }
+        self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.write(info, data)
+    }
+
+    /// The entry's metadata, or `NoObject` / `NoSubIndex`.
+    fn entry(&self, index: u16, sub: u8) -> Result<&'static EntryInfo, SdoAbort> {
+        find(self.entries(), index, sub)
+    }
+
+    /// Reads the value from byte `offset` into `buf`, after the access check for `side`.
+    fn read(&mut self, index: u16, sub: u8, offset: usize, buf: &mut [u8], side: Side) -> Result<ReadLen, SdoAbort> {
+        let info = self.entry(index, sub)?;
+        info.check_read(side)?;
+        self.read_entry(info, index, sub, offset, buf)
+    }
+
+    /// Writes `data` after the checks for `side`: access, state, length and value.
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side, ctx: &AccessContext) -> Result<(), SdoAbort> {
+        let info = self.entry(index, sub)?;
+        info.check_write_access(side, ctx)?;
+        self.write_entry(info, index, sub, data)
+    }
+}
+
+/// A range of object indices: what 1010h/1011h sub-indices and NMT resets act on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Area {
+    // Private: every area is one of the constants below, a union of whole index classes
+    // (0000h..0FFFh, communication, manufacturer, application, A000h..FFFFh). Generated resets
+    // test one index per run of a class and rely on that.
+    first: u16,
+    last: u16,
+}
+
+impl Area {
+    pub const ALL: Area = Area { first: 0x0000, last: 0xFFFF };
+    /// 1000h..1FFFh: what "reset communication" and 1010h sub 2 act on.
+    pub const COMMUNICATION: Area = Area { first: 0x1000, last: 0x1FFF };
+    /// 6000h..9FFFh (1010h sub 3).
+    pub const APPLICATION: Area = Area { first: 0x6000, last: 0x9FFF };
+    /// 2000h..5FFFh (1010h sub 4).
+    pub const MANUFACTURER: Area = Area { first: 0x2000, last: 0x5FFF };
+
+    pub const fn contains(self, index: u16) -> bool {
+        self.first <= index && index <= self.last
+    }
+
+    /// The area a 1010h/1011h sub-index names (CiA 301 7.5.2.13).
+    pub const fn of_store_sub(sub: u8) -> Option<Area> {
+        match sub {
+            1 => Some(Area::ALL),
+            2 => Some(Area::COMMUNICATION),
+            3 => Some(Area::APPLICATION),
+            4 => Some(Area::MANUFACTURER),
+            _ => None,
+        }
+    }
+}
+
+/// Optional communication objects whose services cost code: a dictionary without one (in
+/// every mode) leaves that code out of the image, since the stack tests these constants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CommObjects {
+    /// 1003h, the pre-defined error field (error history).
+    pub error_history: bool,
+    /// 1006h, the communication cycle period (SYNC timeout monitoring).
+    pub sync_cycle: bool,
+    /// 1016h, the consumer heartbeat times.
+    pub heartbeat_consumer: bool,
+}
+
+impl CommObjects {
+    /// Every service, as for a dictionary that has every object.
+    pub const ALL: CommObjects = CommObjects { error_history: true, sync_cycle: true, heartbeat_consumer: true };
+}
+
+/// What a node needs from a generated dictionary besides reads and writes: the spec
+/// defaults, the persistent block and the emergencies.
+pub trait NodeDictionary: EntryAccess {
+    /// Bytes of the persistent block (every `storage: persistent` entry, index order).
+    const PERSISTENT_SIZE: usize;
+
+    /// Whether the SDO server does block transfer (the spec's `sdo_block_transfer`).
+    const SDO_BLOCK_TRANSFER: bool;
+
+    /// The optional communication objects the dictionary has in any mode.
+    const COMM: CommObjects;
+
+    /// Hands the image of every persistent entry of `area` to `sink` with its offset in the
+    /// block, so the block is written without a buffer of its size; `false` if `sink` failed.
+    fn save_area(&self, area: Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool;
+
+    /// Loads every persistent entry of `area` from `source` (offset, buffer to fill); an entry
+    /// whose image `source` cannot give keeps its value, and the result is `false`.
+    fn load_area(&mut self, area: Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool;
+
+    /// Sets every stored entry (RAM and persistent) of `area` back to its spec default,
+    /// `$NODEID` resolved for `node_id`. App-backed entries are the device's business.
+    fn reset_area(&mut self, area: Area, node_id: u8);
+
+    /// The spec's emergencies in the dictionary's mode.
+    fn emergencies(&self) -> &'static [crate::emcy::EmcyDefault];
+}
+
+/// Objects whose data the device keeps outside the dictionary (EEPROM banks, a memory card):
+/// the generated dictionary routes their reads and writes here, after its access checks.
+/// `entry` may describe a run of sub-indices and of repeated objects; `index`/`sub` is the one
+/// accessed.
+pub trait AppObjects {
+    fn read(&mut self, entry: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
+    fn write(&mut self, entry: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
+}
+
+/// For devices without app-backed objects: nothing is routed here.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct NoAppObjects;
+
+impl AppObjects for NoAppObjects {
+    fn read(&mut self, _: &EntryInfo, _: u16, _: u8, _: usize, _: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        Err(SdoAbort::NoObject)
+    }
+    fn write(&mut self, _: &EntryInfo, _: u16, _: u8, _: &[u8]) -> Result<(), SdoAbort> {
+        Err(SdoAbort::NoObject)
+    }
+}

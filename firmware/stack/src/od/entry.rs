@@ -1,0 +1,285 @@
+//! What the runtime knows about an entry, and the checks every access passes: one rule, one
+//! abort code, one place, whichever side asks.
+
+use super::{AccessContext, NmtStates, SdoAbort, Side};
+use coforge_types::{Access, DataType, HostAccess, Storage};
+
+/// Value limits of an entry, kept out of line: most entries have none.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limits {
+    pub low: Option<i64>,
+    pub high: Option<i64>,
+    /// If not empty, the only values a write may store.
+    pub values: &'static [i64],
+}
+
+/// What the runtime knows about an entry, or about a run of identical entries (the 128 bytes
+/// of a memory block share one `EntryInfo` with `sub..=last_sub`), so that the generated
+/// table stays small in flash.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EntryInfo {
+    pub index: u16,
+    /// The number of the object in the generated dictionary, dense from 0 and the same in
+    /// every mode: what its field dispatch switches on, so the switch is a jump table.
+    pub object: u16,
+    /// First sub-index this description covers.
+    pub sub: u8,
+    /// Last sub-index this description covers (equal to `sub` for a single entry).
+    pub last_sub: u8,
+    /// How many further objects, `index + 1 ..= index + copies`, this run also describes:
+    /// objects that repeat alike (CO401Memory1's 64 memory blocks) share their runs. Only
+    /// app-backed objects repeat, so the field dispatch never sees a copy. At most
+    /// [`MAX_COPIES`](crate::pdo::mapping::MAX_COPIES).
+    pub copies: u8,
+    pub data_type: DataType,
+    /// CAN-side access.
+    pub access: Access,
+    /// Serial-host access.
+    pub host_access: HostAccess,
+    /// Host writes are accepted only until the CANopen interface is enabled.
+    pub host_write_before_can_enabled: bool,
+    pub pdo_mappable: bool,
+    pub storage: Storage,
+    /// NMT states in which a bus write is accepted.
+    pub writable_in: NmtStates,
+    /// Size in bytes; for strings and domains the maximum.
+    pub size: u16,
+    pub limits: Option<&'static Limits>,
+}
+
+/// How much of a value a read copied, and how long the value is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReadLen {
+    pub copied: usize,
+    pub total: usize,
+}
+
+impl EntryInfo {
+    /// Whether `side` may read this entry, with the abort code if not.
+    pub fn check_read(&self, side: Side) -> Result<(), SdoAbort> {
+        match side {
+            Side::Device => Ok(()),
+            Side::Bus if self.access == Access::None => Err(SdoAbort::NoObject),
+            Side::Bus if !self.access.readable() => Err(SdoAbort::WriteOnly),
+            Side::Host if self.host_access == HostAccess::None => Err(SdoAbort::UnsupportedAccess),
+            Side::Host if !self.host_access.readable() => Err(SdoAbort::WriteOnly),
+            Side::Bus | Side::Host => Ok(()),
+        }
+    }
+
+    /// Whether `side` may write `data` to this entry: access, state, length and value.
+    pub fn check_write(&self, side: Side, ctx: &AccessContext, data: &[u8]) -> Result<(), SdoAbort> {
+        self.check_write_access(side, ctx)?;
+        self.check_data(data)
+    }
+
+    /// Whether `data` fits this entry: length and value, whoever writes it.
+    pub fn check_data(&self, data: &[u8]) -> Result<(), SdoAbort> {
+        // The common case first: full length, no limits, not a BOOLEAN.
+        if data.len() == usize::from(self.size) && self.limits.is_none() && self.data_type != DataType::Boolean {
+            return Ok(());
+        }
+        self.check_length(data.len())?;
+        self.check_value(data)
+    }
+
+    /// Whether `side` may write this entry now, whatever the value: access and state.
+    pub fn check_write_access(&self, side: Side, ctx: &AccessContext) -> Result<(), SdoAbort> {
+        match side {
+            Side::Device => {}
+            Side::Bus => {
+                if self.access == Access::None {
+                    return Err(SdoAbort::NoObject);
+                }
+                if !self.access.writable() {
+                    return Err(SdoAbort::ReadOnly);
+                }
+                if !self.writable_in.contains(ctx.nmt) {
+                    return Err(SdoAbort::DataTransferState);
+                }
+            }
+            Side::Host => {
+                if !self.host_access.writable() {
+                    return Err(if self.host_access == HostAccess::None { SdoAbort::UnsupportedAccess } else { SdoAbort::ReadOnly });
+                }
+                if self.host_write_before_can_enabled && ctx.can_enabled {
+                    return Err(SdoAbort::DataTransferState);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether this description covers `sub`.
+    pub fn covers(&self, sub: u8) -> bool {
+        (self.sub..=self.last_sub).contains(&sub)
+    }
+
+    /// Whether this run describes object `index` (its own, or one of its copies).
+    pub fn covers_index(&self, index: u16) -> bool {
+        index >= self.index && index - self.index <= u16::from(self.copies)
+    }
+
+    fn check_length(&self, len: usize) -> Result<(), SdoAbort> {
+        let size = usize::from(self.size);
+        let variable = matches!(self.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
+        if len > size {
+            Err(SdoAbort::LengthTooHigh)
+        } else if len < size && !variable {
+            Err(SdoAbort::LengthTooLow)
+        } else {
+            Ok(())
+        }
+    }
+
+    fn check_value(&self, data: &[u8]) -> Result<(), SdoAbort> {
+        // Fast path for the common entry without limits: a value of the right length always
+        // fits its integer type, except a BOOLEAN byte holding 2..255.
+        if self.limits.is_none() {
+            return match (self.data_type, data) {
+                (DataType::Boolean, [b]) if *b > 1 => Err(SdoAbort::ValueTooHigh),
+                _ => Ok(()),
+            };
+        }
+        let Some(value) = decode_int(self.data_type, data) else { return Ok(()) };
+        // Only BOOLEAN can carry bits its type does not allow (a byte holding 2..255).
+        if self.data_type.int_range().is_some_and(|(_, hi)| value > hi) {
+            return Err(SdoAbort::ValueTooHigh);
+        }
+        let Some(limits) = self.limits else { return Ok(()) };
+        if !limits.values.is_empty() && !limits.values.iter().any(|&v| i128::from(v) == value) {
+            return Err(SdoAbort::InvalidValue);
+        }
+        if limits.low.is_some_and(|low| value < i128::from(low)) {
+            return Err(SdoAbort::ValueTooLow);
+        }
+        if limits.high.is_some_and(|high| value > i128::from(high)) {
+            return Err(SdoAbort::ValueTooHigh);
+        }
+        Ok(())
+    }
+}
+
+/// The value of a little-endian integer entry (BOOLEAN counts as 0/1); `None` for other types
+/// or a length that does not match the type.
+pub fn decode_int(data_type: DataType, data: &[u8]) -> Option<i128> {
+    let (lo, _) = data_type.int_range()?;
+    let bits = data_type.bits()?;
+    let bytes = usize::try_from(bits.div_ceil(8)).ok()?;
+    if data.len() != bytes {
+        return None;
+    }
+    // At most 64 bits: assembled in a u64, widened once (128-bit shifts are costly on a
+    // Cortex-M0).
+    let raw = data.iter().rev().fold(0_u64, |acc, &b| acc << 8 | u64::from(b));
+    // Signed types: sign-extend from the type's width by shifting its sign bit to bit 63.
+    let unused = 64 - bits;
+    if lo < 0 { Some(i128::from(((raw << unused) as i64) >> unused)) } else { Some(i128::from(raw)) }
+}
+
+/// An entry at 2000h.0 with no limits, for unit tests.
+#[cfg(test)]
+pub(crate) const fn test_entry(data_type: DataType, access: Access, host_access: HostAccess, size: u16) -> EntryInfo {
+    EntryInfo {
+        index: 0x2000,
+        object: 0,
+        sub: 0,
+        last_sub: 0,
+        copies: 0,
+        data_type,
+        access,
+        host_access,
+        host_write_before_can_enabled: false,
+        pdo_mappable: false,
+        storage: Storage::Ram,
+        writable_in: NmtStates::ALL,
+        size,
+        limits: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use coforge_types::NmtState;
+
+    const fn info(data_type: DataType, access: Access, host_access: HostAccess, size: u16) -> EntryInfo {
+        test_entry(data_type, access, host_access, size)
+    }
+
+    const OP: AccessContext = AccessContext { nmt: NmtState::Operational, can_enabled: true };
+    const PREOP: AccessContext = AccessContext { nmt: NmtState::PreOperational, can_enabled: false };
+
+    #[test]
+    fn access_differs_by_side() {
+        // CO401GW1 2E00: read-only from CAN, writable by the host.
+        let e = info(DataType::Unsigned8, Access::Ro, HostAccess::Rw, 1);
+        assert_eq!(e.check_write(Side::Bus, &OP, &[1]), Err(SdoAbort::ReadOnly));
+        assert_eq!(e.check_write(Side::Host, &OP, &[1]), Ok(()));
+        assert_eq!(e.check_write(Side::Device, &OP, &[1]), Ok(()));
+        // A write-only CAN entry (CO401Memory1 5E00): readable by the host only.
+        let m = info(DataType::Unsigned8, Access::Wo, HostAccess::Ro, 1);
+        assert_eq!(m.check_read(Side::Bus), Err(SdoAbort::WriteOnly));
+        assert_eq!(m.check_read(Side::Host), Ok(()));
+        assert_eq!(m.check_write(Side::Host, &OP, &[1]), Err(SdoAbort::ReadOnly));
+        // Not reachable from CAN at all (CO401GW1 100B).
+        let n = EntryInfo { host_write_before_can_enabled: true, ..info(DataType::Unsigned8, Access::None, HostAccess::Rw, 1) };
+        assert_eq!(n.check_read(Side::Bus), Err(SdoAbort::NoObject));
+        assert_eq!(n.check_write(Side::Bus, &PREOP, &[5]), Err(SdoAbort::NoObject));
+        assert_eq!(n.check_write(Side::Host, &PREOP, &[5]), Ok(()));
+        assert_eq!(n.check_write(Side::Host, &OP, &[5]), Err(SdoAbort::DataTransferState), "only before the CAN interface is enabled");
+        let h = info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1);
+        assert_eq!(h.check_read(Side::Host), Err(SdoAbort::UnsupportedAccess));
+    }
+
+    #[test]
+    fn writes_restricted_to_nmt_states() {
+        let e = EntryInfo { writable_in: NmtStates::NONE.with(NmtState::PreOperational), ..info(DataType::Unsigned32, Access::Rw, HostAccess::None, 4) };
+        assert_eq!(e.check_write(Side::Bus, &PREOP, &[0; 4]), Ok(()));
+        assert_eq!(e.check_write(Side::Bus, &OP, &[0; 4]), Err(SdoAbort::DataTransferState));
+    }
+
+    #[test]
+    fn lengths_and_values_are_checked() {
+        static NODE_ID: Limits = Limits { low: Some(1), high: Some(127), values: &[] };
+        let e = EntryInfo { limits: Some(&NODE_ID), ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
+        assert_eq!(e.check_write(Side::Bus, &OP, &[]), Err(SdoAbort::LengthTooLow));
+        assert_eq!(e.check_write(Side::Bus, &OP, &[1, 2]), Err(SdoAbort::LengthTooHigh));
+        assert_eq!(e.check_write(Side::Bus, &OP, &[0]), Err(SdoAbort::ValueTooLow));
+        assert_eq!(e.check_write(Side::Bus, &OP, &[128]), Err(SdoAbort::ValueTooHigh));
+        assert_eq!(e.check_write(Side::Device, &OP, &[128]), Err(SdoAbort::ValueTooHigh), "limits bind the device too");
+        static MODES: Limits = Limits { low: None, high: None, values: &[1, 2, 3, 0x10] };
+        let v = EntryInfo { limits: Some(&MODES), ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
+        assert_eq!(v.check_write(Side::Bus, &OP, &[0x10]), Ok(()));
+        assert_eq!(v.check_write(Side::Bus, &OP, &[4]), Err(SdoAbort::InvalidValue));
+        let b = info(DataType::Boolean, Access::Rw, HostAccess::None, 1);
+        assert_eq!(b.check_write(Side::Bus, &OP, &[1]), Ok(()));
+        assert_eq!(b.check_write(Side::Bus, &OP, &[2]), Err(SdoAbort::ValueTooHigh));
+        let s = info(DataType::VisibleString, Access::Rw, HostAccess::None, 8);
+        assert_eq!(s.check_write(Side::Bus, &OP, b"Datei1"), Ok(()), "strings may be shorter than their maximum");
+        assert_eq!(s.check_write(Side::Bus, &OP, b"123456789"), Err(SdoAbort::LengthTooHigh));
+        static SIGNED: Limits = Limits { low: Some(-100), high: Some(100), values: &[] };
+        let i = EntryInfo { limits: Some(&SIGNED), ..info(DataType::Integer16, Access::Rw, HostAccess::None, 2) };
+        assert_eq!(i.check_write(Side::Bus, &OP, &(-100_i16).to_le_bytes()), Ok(()));
+        assert_eq!(i.check_write(Side::Bus, &OP, &(-101_i16).to_le_bytes()), Err(SdoAbort::ValueTooLow));
+    }
+
+    #[test]
+    fn integers_decode_little_endian_with_sign() {
+        assert_eq!(decode_int(DataType::Unsigned16, &[0x34, 0x12]), Some(0x1234));
+        assert_eq!(decode_int(DataType::Integer8, &[0xFF]), Some(-1));
+        assert_eq!(decode_int(DataType::Integer24, &[0x00, 0x00, 0x80]), Some(-0x80_0000));
+        assert_eq!(decode_int(DataType::Unsigned64, &[0xFF; 8]), Some(i128::from(u64::MAX)));
+        assert_eq!(decode_int(DataType::Integer64, &[0xFF; 8]), Some(-1));
+        assert_eq!(decode_int(DataType::Unsigned32, &[1, 2]), None);
+        assert_eq!(decode_int(DataType::VisibleString, b"x"), None);
+    }
+
+    #[test]
+    fn entry_info_is_small_enough_for_flash_tables() {
+        // Most of a dictionary's flash is this table: 16 bytes and the limits pointer per run
+        // (20 bytes on Cortex-M).
+        let most = 16 + core::mem::size_of::<Option<&Limits>>();
+        assert!(core::mem::size_of::<EntryInfo>() <= most, "{}", core::mem::size_of::<EntryInfo>());
+    }
+}

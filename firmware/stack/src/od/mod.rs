@@ -1,0 +1,31 @@
+//! The object dictionary interface: what generated dictionaries implement and every engine of
+//! the node reads and writes through.
+//!
+//! Generated code keeps the data in typed fields and dispatches with a `match`; everything
+//! that decides *whether* an access is allowed lives here, once, so every device and both
+//! sides (bus and host) refuse the same things with the same CiA 301 abort code.
+//!
+//! - [`abort`]: the CiA 301 SDO abort codes;
+//! - [`side`]: who accesses ([`Side`]) and the state a write is judged in ([`AccessContext`]);
+//! - [`entry`]: [`EntryInfo`], an entry's (or a run's) metadata, and its access checks;
+//! - [`lookup`]: finding a run in a generated table, copying values out;
+//! - [`dictionary`]: the two traits a generated dictionary implements, [`EntryAccess`]
+//!   (lookup, reads and writes of entries) and [`NodeDictionary`] (what the node needs besides:
+//!   defaults, persistence, emergencies, the mode), and [`AppObjects`], the owner of the
+//!   objects a device keeps outside the dictionary.
+
+pub mod abort;
+pub mod dictionary;
+pub mod entry;
+pub mod lookup;
+pub mod side;
+
+pub use abort::SdoAbort;
+pub use coforge_types::{Access, DataType, HostAccess, NmtState, Storage};
+pub use dictionary::{AppObjects, Area, CommObjects, EntryAccess, NoAppObjects, NodeDictionary};
+pub use entry::{EntryInfo, Limits, ReadLen, decode_int};
+pub use lookup::{find, find_run, read_slice};
+pub use side::{AccessContext, NmtStates, Side};
+
+#[cfg(test)]
+pub(crate) use entry::test_entry;

@@ -1,0 +1,47 @@
+//! Who accesses the dictionary, and the node state a write is judged against.
+
+use coforge_types::NmtState;
+
+/// Who accesses the dictionary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// A CANopen master (SDO) or a received PDO.
+    Bus,
+    /// The serial host, through the device's protocol.
+    Host,
+    /// The device's own behaviour code: no access rule applies, only lengths and limits.
+    Device,
+}
+
+/// A set of NMT states, for entries that may only be written in some of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NmtStates(u8);
+
+impl NmtStates {
+    pub const NONE: NmtStates = NmtStates(0);
+    pub const ALL: NmtStates = NmtStates(0b111);
+
+    const fn bit(state: NmtState) -> u8 {
+        match state {
+            NmtState::PreOperational => 0b001,
+            NmtState::Operational => 0b010,
+            NmtState::Stopped => 0b100,
+        }
+    }
+
+    pub const fn with(self, state: NmtState) -> NmtStates {
+        NmtStates(self.0 | Self::bit(state))
+    }
+
+    pub const fn contains(self, state: NmtState) -> bool {
+        self.0 & Self::bit(state) != 0
+    }
+}
+
+/// What a write is judged against besides the entry itself.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AccessContext {
+    pub nmt: NmtState,
+    /// The host has enabled the CANopen interface (CO401GW1's command 0x02).
+    pub can_enabled: bool,
+}
