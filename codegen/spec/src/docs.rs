@@ -1,5 +1,5 @@
-//! Markdown documentation of a device: identity, hardware tables, the object dictionary,
-//! default PDOs, emergencies, the serial protocol and the errata.
+//! Markdown documentation of a device: identity, node settings, hardware tables, the object
+//! dictionary, default PDOs, emergencies, the serial protocol and the errata.
 
 use crate::eds::{eds_access, eds_value};
 use crate::model::{Device, Direction, FieldType, Framing, ModeSet, SelectorSource};
@@ -36,6 +36,7 @@ pub fn markdown(d: &Device) -> String {
     let _ = writeln!(out, "| SDO block transfer | {} |", if id.sdo_block_transfer { "yes" } else { "no (abort 0504 0001h)" });
     let _ = writeln!(out);
 
+    node(&mut out, d);
     hardware(&mut out, d);
     if !d.modes.is_empty() {
         let _ = writeln!(out, "## Operating modes\n\n| Mode | Selected by | Description |\n|---|---|---|");
@@ -185,6 +186,49 @@ pub fn markdown(d: &Device) -> String {
         let _ = writeln!(out, "| {} | {} | {} | {} | {} |", cell(&e.id), cell(&e.location), cell(&e.datasheet), cell(&e.choice), cell(&e.reason));
     }
     out
+}
+
+/// The `node:` settings, each with what it does (defaults included: they are behaviour too).
+fn node(out: &mut String, d: &Device) {
+    let n = &d.node;
+    // The object's name as the object dictionary gives it (the first definition, for modes).
+    let object = |index: Option<u16>, effect: &str, otherwise: &str| match index {
+        Some(i) => {
+            let name = d.objects.iter().find(|o| o.index == i).map(|o| format!(" ({})", cell(&o.name))).unwrap_or_default();
+            format!("{i:04X}{name}: {effect}")
+        }
+        None => format!("none: {otherwise}"),
+    };
+    let flag = |on: bool, yes: &str, no: &str| if on { format!("yes: {yes}") } else { format!("no: {no}") };
+    let rows = [
+        (
+            "restart_time_object",
+            object(n.restart_time_object, "bus-off restart time in ms, 0 = no automatic restart", "the node does not restart the CAN controller after bus off"),
+        ),
+        ("bootup_object", object(n.bootup_object, "0 suppresses the boot-up message", "the boot-up message is always sent")),
+        (
+            "startup_object",
+            object(n.startup_object, "1 makes the node enter Operational by itself after boot-up", "the node stays pre-operational until an NMT start"),
+        ),
+        (
+            "rpdo_deadline_monitoring",
+            flag(
+                n.rpdo_deadline_monitoring,
+                "an RPDO's event timer (14xxh.5) is a deadline monitor (EMCY 8250h)",
+                "an RPDO's event timer is not monitored (as in DS301 4.0)",
+            ),
+        ),
+        (
+            "combine_emcy_codes",
+            flag(n.combine_emcy_codes, "emergency bytes 3..7 carry the OR of every active error's bytes", "emergency bytes 3..7 are those of the error sent"),
+        ),
+        ("auto_save", flag(n.auto_save, "persistent entries are saved as soon as they are written", "persistent entries are saved by a write to 1010")),
+    ];
+    let _ = writeln!(out, "## CANopen node\n\nHow the node differs from a plain CiA 301 slave (spec `node:`).\n\n| Setting | Value |\n|---|---|");
+    for (key, value) in rows {
+        let _ = writeln!(out, "| `{key}` | {value} |");
+    }
+    let _ = writeln!(out);
 }
 
 fn hardware(out: &mut String, d: &Device) {

@@ -1,6 +1,7 @@
 //! Canonical formatting of spec files (`coforge fmt`), so that diffs stay reviewable.
 //!
 //! The file is parsed into a tree of YAML nodes and written back with fixed rules:
+//! - the top-level sections in the order of [`SECTIONS`] (unknown keys last, as written);
 //! - two spaces per level; sequence items indented under their key;
 //! - one blank line between top-level keys, none elsewhere;
 //! - flow collections (`{ a: 1 }`, `[a, b]`) stay flow, on one line, with single spaces;
@@ -16,6 +17,9 @@ use std::fmt::Write as _;
 
 /// Folded text is wrapped to this many columns (including indentation) where it can be.
 pub const WIDTH: usize = 100;
+
+/// The top-level sections of a spec in canonical order (`spec/README.md`).
+pub const SECTIONS: &[&str] = &["format", "device", "node", "hardware", "modes", "objects", "pdo", "emergencies", "serial", "redundant_pairs", "errata"];
 
 #[derive(Debug, Clone, PartialEq)]
 enum Node {
@@ -50,7 +54,12 @@ pub fn format(text: &str) -> Result<String, String> {
     if it.next().is_some() {
         return Err("a spec file holds exactly one YAML document".into());
     }
-    let Node::Map(false, entries) = root else { return Err("a spec file is a block mapping at the top level".into()) };
+    let Node::Map(false, mut entries) = root else { return Err("a spec file is a block mapping at the top level".into()) };
+    // A stable sort: keys that are not sections (errors for `coforge check`) keep their order.
+    entries.sort_by_key(|(k, _)| match k {
+        Node::Scalar(key, ScalarStyle::Plain) => SECTIONS.iter().position(|s| s == key).unwrap_or(SECTIONS.len()),
+        _ => SECTIONS.len(),
+    });
     let mut out = String::new();
     for (i, (k, v)) in entries.iter().enumerate() {
         if i > 0 {
@@ -271,6 +280,14 @@ mod tests {
     fn layout_rules() {
         let src = "format: 1\nobjects:\n- index: 0x1000\n  subs:\n      - {sub: 0,   name: 'it''s'}\n  tags: [a,b]\nname:    \"q\\\"x\"\n";
         let want = "format: 1\n\nobjects:\n  - index: 0x1000\n    subs:\n      - { sub: 0, name: 'it''s' }\n    tags: [a, b]\n\nname: \"q\\\"x\"\n";
+        assert_eq!(format(src).as_deref(), Ok(want));
+        assert_eq!(format(want).as_deref(), Ok(want), "formatting is idempotent");
+    }
+
+    #[test]
+    fn sections_are_put_in_canonical_order() {
+        let src = "format: 1\nobjects: []\nnode:\n  auto_save: true\n  bootup_object: 0x2110\nunknown: 1\ndevice: { name: x }\n";
+        let want = "format: 1\n\ndevice: { name: x }\n\nnode:\n  auto_save: true\n  bootup_object: 0x2110\n\nobjects: []\n\nunknown: 1\n";
         assert_eq!(format(src).as_deref(), Ok(want));
         assert_eq!(format(want).as_deref(), Ok(want), "formatting is idempotent");
     }

@@ -9,6 +9,10 @@ use std::collections::{BTreeMap, BTreeSet};
 #[derive(Debug, Clone)]
 pub struct Device {
     pub identity: Identity,
+    /// The spec's `node:` section (all defaults without one).
+    pub node: NodeSettings,
+    /// Where each object setting of `node:` stands in the spec, for diagnostics.
+    pub node_spans: NodeSpans,
     pub hardware: Hardware,
     pub modes: Vec<Mode>,
     /// Sorted by index, then by mode set.
@@ -38,6 +42,59 @@ pub struct Identity {
     pub datasheet_version: String,
     pub datasheet_file: String,
     pub span: Span,
+}
+
+/// How the device's CANopen node differs from a plain CiA 301 slave (the spec's `node:`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NodeSettings {
+    pub restart_time_object: Option<u16>,
+    pub bootup_object: Option<u16>,
+    pub startup_object: Option<u16>,
+    pub rpdo_deadline_monitoring: bool,
+    pub combine_emcy_codes: bool,
+    pub auto_save: bool,
+}
+
+/// Plain CiA 301: no device-specific objects, RPDO deadline monitoring on, emergency
+/// manufacturer bytes not combined, persistent entries saved only through 1010.
+impl Default for NodeSettings {
+    fn default() -> Self {
+        NodeSettings {
+            restart_time_object: None,
+            bootup_object: None,
+            startup_object: None,
+            rpdo_deadline_monitoring: true,
+            combine_emcy_codes: false,
+            auto_save: false,
+        }
+    }
+}
+
+impl NodeSettings {
+    /// The settings that name an object, by spec key: the node reads sub 0 of each at run time.
+    pub fn objects(&self) -> [(&'static str, Option<u16>); 3] {
+        [("restart_time_object", self.restart_time_object), ("bootup_object", self.bootup_object), ("startup_object", self.startup_object)]
+    }
+}
+
+/// Positions of the object settings in `node:` ([`Span::NONE`] where absent).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct NodeSpans {
+    pub restart_time_object: Span,
+    pub bootup_object: Span,
+    pub startup_object: Span,
+}
+
+impl NodeSpans {
+    /// The position of an object setting by its spec key (as in [`NodeSettings::objects`]).
+    pub fn of(&self, key: &str) -> Span {
+        match key {
+            "restart_time_object" => self.restart_time_object,
+            "bootup_object" => self.bootup_object,
+            "startup_object" => self.startup_object,
+            _ => Span::NONE,
+        }
+    }
 }
 
 /// The modes an item exists in; `None` means every mode.

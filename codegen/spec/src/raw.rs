@@ -56,6 +56,8 @@ pub struct Spec {
     pub format: S<u32>,
     pub device: S<Device>,
     #[serde(default)]
+    pub node: Option<S<Node>>,
+    #[serde(default)]
     pub hardware: Option<S<Hardware>>,
     #[serde(default)]
     pub modes: Vec<S<Mode>>,
@@ -97,6 +99,25 @@ pub struct Datasheet {
     pub title: String,
     pub version: String,
     pub file: String,
+}
+
+/// `node:`: how the CANopen node differs from a plain CiA 301 slave. Absent keys keep the
+/// CiA 301 behaviour.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Node {
+    #[serde(default)]
+    pub restart_time_object: Option<Num>,
+    #[serde(default)]
+    pub bootup_object: Option<Num>,
+    #[serde(default)]
+    pub startup_object: Option<Num>,
+    #[serde(default)]
+    pub rpdo_deadline_monitoring: Option<bool>,
+    #[serde(default)]
+    pub combine_emcy_codes: Option<bool>,
+    #[serde(default)]
+    pub auto_save: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]

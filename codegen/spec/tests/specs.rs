@@ -3,7 +3,7 @@
 
 mod common;
 
-use coforge_spec::model::{Device, Framing, PdoDir};
+use coforge_spec::model::{Device, Framing, NodeSettings, PdoDir};
 use coforge_spec::types::{Access, DataType, HostAccess, Storage, WriteWhen};
 use coforge_spec::{eds, fmt, load_str};
 use common::{crate_dir, files, golden, repo_dir};
@@ -135,6 +135,52 @@ fn canopenia_crc_is_xmodem_and_node_table_has_127_nodes() {
         assert!(codes.contains(&u32::from(letter)), "command {letter}");
     }
     assert!(d.errata.iter().any(|e| e.datasheet.contains("x^16") || e.datasheet.contains("x16")), "CRC polynomial conflict recorded");
+}
+
+#[test]
+fn node_settings_are_what_each_firmware_needs() {
+    let cia301 = NodeSettings::default();
+    assert_eq!(
+        cia301,
+        NodeSettings {
+            restart_time_object: None,
+            bootup_object: None,
+            startup_object: None,
+            rpdo_deadline_monitoring: true,
+            combine_emcy_codes: false,
+            auto_save: false
+        }
+    );
+    let expected = [
+        // frenzel+berg CAN restart time 2180h; CO40xx codes ORed; DS301 4.0 without RPDO deadlines (MEM-27).
+        (
+            "co401memory1.yaml",
+            NodeSettings { restart_time_object: Some(0x2180), combine_emcy_codes: true, rpdo_deadline_monitoring: false, ..NodeSettings::default() },
+        ),
+        // CAN restart time 2180h, boot-up message switch 2110h; no RPDO deadlines (GW1-13).
+        (
+            "co401gw1.yaml",
+            NodeSettings { restart_time_object: Some(0x2180), bootup_object: Some(0x2110), rpdo_deadline_monitoring: false, ..NodeSettings::default() },
+        ),
+        // 20F4h "CANopen StartUp mode"; all parameters are saved automatically.
+        ("cr3101.yaml", NodeSettings { startup_object: Some(0x20F4), auto_save: true, ..NodeSettings::default() }),
+        ("canopenia.yaml", NodeSettings::default()),
+    ];
+    for (name, want) in expected {
+        let d = load(name);
+        assert_eq!(d.node, want, "{name}");
+        for (key, index) in d.node.objects() {
+            let Some(index) = index else { continue };
+            for mode in d.mode_names() {
+                let e = d.object(index, mode).and_then(|o| o.entry(0)).unwrap_or_else(|| panic!("{name}: node.{key} {index:04X} in {mode:?}"));
+                assert!(e.access.readable() && e.access.writable(), "{name}: node.{key} {index:04X} is configurable over CAN");
+            }
+        }
+    }
+    let gw1 = load("co401gw1.yaml");
+    assert!(gw1.errata.iter().any(|e| e.id == "GW1-13" && e.choice.contains("node.rpdo_deadline_monitoring")));
+    let mem = load("co401memory1.yaml");
+    assert!(mem.errata.iter().any(|e| e.id == "MEM-27" && e.choice.contains("node.rpdo_deadline_monitoring")));
 }
 
 #[test]

@@ -7,6 +7,7 @@ use crate::model::Device;
 mod emcy;
 mod errata;
 mod hardware;
+mod node;
 mod od;
 mod pdo;
 mod serial;
@@ -35,6 +36,13 @@ pub const RULES: &[Rule] = &[
     Rule { id: "od-limits", summary: "a low limit exceeds the high limit, or a limit does not fit the type", check: od::limits },
     Rule { id: "od-storage", summary: "persistent entries exist but the store/restore objects 1010/1011 do not", check: od::storage },
     Rule { id: "od-identity", summary: "1000/1018 defaults disagree with the device identity", check: od::identity },
+    Rule { id: "node-object", summary: "a `node` setting names an object that is missing in some mode", check: node::object },
+    Rule {
+        id: "node-object-type",
+        summary: "a `node` setting names an object that is not a VAR of an unsigned integer type (restart time: UNSIGNED16)",
+        check: node::object_type,
+    },
+    Rule { id: "node-object-access", summary: "a `node` setting names an object that cannot be read (`wo` or `none`)", check: node::object_access },
     Rule { id: "pdo-duplicate", summary: "a PDO number is defined twice in one mode", check: pdo::duplicate },
     Rule { id: "pdo-mapping-target", summary: "a default mapping points at a missing object or sub-index", check: pdo::mapping_target },
     Rule { id: "pdo-mapping-mappable", summary: "a default mapping maps an entry that is not PDO-mappable", check: pdo::mapping_mappable },
