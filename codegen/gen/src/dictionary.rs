@@ -4,8 +4,9 @@
 //! object number, so reads and writes share one jump table and their code lives in the stack.
 
 use crate::Options;
+use crate::modes::Modes;
 use crate::naming::{camel, ident as id};
-use coforge_spec::model::{Device, Entry, Object, Value};
+use coforge_spec::model::{Device, Entry, Object, Value, in_mode};
 use coforge_spec::types::{DataType, ObjectKind, Storage};
 use proc_macro2::{Ident, TokenStream};
 use quote::quote;
@@ -17,8 +18,28 @@ struct Slot<'a> {
     /// Dense object number ([`object_numbers`]).
     number: u16,
     object: &'a Object,
-    /// sub -> the entry (first mode wins for defaults and types).
+    /// sub -> the entry (first mode wins for types).
     entries: BTreeMap<u8, &'a Entry>,
+}
+
+/// The spec default of an entry in each mode it exists in: `(mode variant, default tokens)`.
+type ModeDefaults = Vec<(Ident, TokenStream)>;
+
+/// The default of `index`/`sub` in every mode, in the field's Rust type.
+fn mode_defaults(d: &Device, modes: &Modes, index: u16, sub: u8, stack: &TokenStream) -> ModeDefaults {
+    let mut out = Vec::new();
+    for (variant, mode) in &modes.variants {
+        let entry = d
+            .objects
+            .iter()
+            .filter(|o| o.index == index && in_mode(&o.modes, mode.as_deref()))
+            .flat_map(|o| &o.entries)
+            .find(|e| e.sub == sub && in_mode(&e.modes, mode.as_deref()));
+        if let Some(e) = entry {
+            out.push((variant.clone(), initial(e, stack)));
+        }
+    }
+    out
 }
 
 /// Every index of the device, in every mode, numbered densely in index order: the
@@ -131,12 +152,26 @@ struct Place {
     index: TokenStream,
     place: TokenStream,
     ty: TokenStream,
+    /// The default: one expression, or a `match self.mode` where the modes differ.
     default: TokenStream,
+    /// Whether the default differs between the modes the entry exists in.
+    per_mode: bool,
 }
 
 impl Parts {
-    fn place(&mut self, e: &Entry, number: u16, place: TokenStream, ty: TokenStream, default: TokenStream) {
-        let p = Place { number, index: crate::hex(number.into(), 4), place, ty, default };
+    fn place(&mut self, e: &Entry, number: u16, place: TokenStream, ty: TokenStream, defaults: ModeDefaults) {
+        let distinct: std::collections::BTreeSet<String> = defaults.iter().map(|(_, t)| t.to_string()).collect();
+        let per_mode = distinct.len() > 1;
+        let default = match defaults.as_slice() {
+            [(_, only), ..] if !per_mode => only.clone(),
+            _ => {
+                // Modes the entry does not exist in keep the first mode's value: no table
+                // lists the entry there, so nothing reads it.
+                let arms = defaults.iter().map(|(v, t)| quote!(Mode::#v => #t));
+                quote!(match self.mode { #(#arms,)* #[allow(unreachable_patterns)] _ => Default::default() })
+            }
+        };
+        let p = Place { number, index: crate::hex(number.into(), 4), place, ty, default, per_mode };
         if persistent(e) {
             self.persist.push(p.clone());
         }
@@ -148,7 +183,10 @@ fn persistent(e: &Entry) -> bool {
     e.storage == Storage::Persistent
 }
 
-fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
+/// The defaults of one entry of the slot being generated, per mode.
+type DefaultsOf<'a> = &'a dyn Fn(u8) -> ModeDefaults;
+
+fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults: DefaultsOf<'_>) {
     let number = crate::dec(slot.number.into());
     let o = slot.object;
     // App-backed entries never reach `field`: the stack routes them by their storage class.
@@ -159,21 +197,21 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
     let field = id(&o.ident);
     let doc = format!(" {:04X}h {}", slot.index, o.name);
     match o.kind {
-        ObjectKind::Var | ObjectKind::Domain => plain_field(kept[0], &field, &doc, slot.index, &number, stack, parts),
+        ObjectKind::Var | ObjectKind::Domain => plain_field(kept[0], &field, &doc, slot.index, &number, stack, parts, defaults),
         ObjectKind::Array => {
             let items: Vec<&Entry> = kept.iter().copied().filter(|e| e.sub > 0).collect();
             let n = items.iter().map(|e| usize::from(e.sub)).max().unwrap_or(0);
             let Some(first) = items.first() else {
                 // Only sub 0 is stored (the elements are app-backed): a plain field.
-                return plain_field(kept[0], &field, &doc, slot.index, &number, stack, parts);
+                return plain_field(kept[0], &field, &doc, slot.index, &number, stack, parts, defaults);
             };
             let ty = rust_type(first, stack);
             if let Some(e) = kept.iter().find(|e| e.sub == 0) {
-                parts.place(e, slot.index, quote!(self.#field.sub0), quote!(u8), initial(e, stack));
+                parts.place(e, slot.index, quote!(self.#field.sub0), quote!(u8), defaults(e.sub));
             }
             for e in &items {
                 let i = crate::dec(u64::from(e.sub) - 1);
-                parts.place(e, slot.index, quote!(self.#field.items[#i]), ty.clone(), initial(e, stack));
+                parts.place(e, slot.index, quote!(self.#field.items[#i]), ty.clone(), defaults(e.sub));
             }
             let count = crate::dec(n as u64);
             parts.fields.push(quote!(#[doc = #doc] pub #field: #stack::value::Array<#ty, #count>));
@@ -187,8 +225,8 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
             for e in &kept {
                 let f = id(&e.ident);
                 let sub = crate::dec(e.sub.into());
-                let (ty, init) = (rust_type(e, stack), initial(e, stack));
-                parts.place(e, slot.index, quote!(self.#field.#f), ty.clone(), init);
+                let ty = rust_type(e, stack);
+                parts.place(e, slot.index, quote!(self.#field.#f), ty.clone(), defaults(e.sub));
                 let sdoc = format!(" Sub {}: {}", e.sub, e.name);
                 sub_fields.push(quote!(#[doc = #sdoc] pub #f: #ty));
                 parts.field_arms.push(quote!((#number, #sub) => &mut self.#field.#f));
@@ -205,9 +243,19 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts) {
 }
 
 /// A single stored entry (a VAR, or sub 0 alone) as one field.
-fn plain_field(e: &Entry, field: &Ident, doc: &str, index: u16, number: &proc_macro2::Literal, stack: &TokenStream, parts: &mut Parts) {
-    let (ty, init) = (rust_type(e, stack), initial(e, stack));
-    parts.place(e, index, quote!(self.#field), ty.clone(), init);
+#[allow(clippy::too_many_arguments)]
+fn plain_field(
+    e: &Entry,
+    field: &Ident,
+    doc: &str,
+    index: u16,
+    number: &proc_macro2::Literal,
+    stack: &TokenStream,
+    parts: &mut Parts,
+    defaults: DefaultsOf<'_>,
+) {
+    let ty = rust_type(e, stack);
+    parts.place(e, index, quote!(self.#field), ty.clone(), defaults(e.sub));
     parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
     parts.names.push(field.clone());
     // The caller has found `sub` in this entry's run, so a single field needs no sub test.
@@ -245,19 +293,23 @@ fn reset_groups(resets: &[Place]) -> Vec<TokenStream> {
         .collect()
 }
 
-pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
+pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let stack = &options.stack;
     let block_transfer = d.identity.sdo_block_transfer;
     let has = |index: u16| d.objects.iter().any(|o| o.index == index);
     let (history, sync_cycle, consumer) = (has(0x1003), has(0x1006), has(0x1016));
     let mut parts = Parts { structs: Vec::new(), fields: Vec::new(), names: Vec::new(), field_arms: Vec::new(), persist: Vec::new(), resets: Vec::new() };
     for slot in slots(d) {
-        slot_parts(&slot, stack, &mut parts);
+        let defaults = |sub| mode_defaults(d, modes, slot.index, sub, stack);
+        slot_parts(&slot, stack, &mut parts, &defaults);
     }
     let Parts { structs, fields, names, field_arms, persist, resets } = parts;
     let (p_index, places): (Vec<&TokenStream>, Vec<&TokenStream>) = persist.iter().map(|p| (&p.index, &p.place)).unzip();
     let types: Vec<&TokenStream> = persist.iter().map(|p| &p.ty).collect();
     let reset_groups = reset_groups(&resets);
+    // What `set_mode` sets: the entries whose default differs between modes.
+    let (mode_targets, mode_values): (Vec<&TokenStream>, Vec<&TokenStream>) = resets.iter().filter(|p| p.per_mode).map(|p| (&p.place, &p.default)).unzip();
+    let node_config = node_config(d, stack);
     quote! {
         #(#structs)*
 
@@ -272,8 +324,9 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
         }
 
         impl<A: #stack::od::AppObjects> Od<A> {
-            /// The dictionary with the spec's defaults, `$NODEID` resolved for `node_id`: all
-            /// zero first, then the one place that knows the defaults, `reset_area`.
+            /// The dictionary with the spec's defaults of `mode`, `$NODEID` resolved for
+            /// `node_id`: all zero first, then the one place that knows the defaults,
+            /// `reset_area`.
             pub fn new(mode: Mode, node_id: u8, app: A) -> Self {
                 use #stack::od::NodeDictionary as _;
                 let mut od = Od { mode, app, #(#names: Default::default()),* };
@@ -286,7 +339,14 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
             }
         }
 
+        /// The node settings of the spec's `node:` section, for `node_id`.
+        pub const fn node_config(node_id: u8) -> #stack::config::NodeConfig {
+            #node_config
+        }
+
         impl<A: #stack::od::AppObjects> #stack::od::NodeDictionary for Od<A> {
+            type Mode = Mode;
+            const MODES: &'static [Mode] = &Mode::ALL;
             const PERSISTENT_SIZE: usize = 0 #(+ <#types as #stack::value::Persist>::SIZE)*;
             const SDO_BLOCK_TRANSFER: bool = #block_transfer;
             const COMM: #stack::od::CommObjects =
@@ -333,6 +393,28 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
             fn emergencies(&self) -> &'static [#stack::emcy::EmcyDefault] {
                 emcy::emergencies(self.mode)
             }
+
+            fn new(mode: Mode, node_id: u8, app: A) -> Self {
+                Od::new(mode, node_id, app)
+            }
+
+            fn mode(&self) -> Mode {
+                self.mode
+            }
+
+            #[allow(unused_variables)]
+            fn set_mode(&mut self, mode: Mode, node_id: u8) {
+                self.mode = mode;
+                #(#mode_targets = #mode_values;)*
+            }
+
+            fn mode_name(mode: Mode) -> &'static str {
+                mode.name()
+            }
+
+            fn node_config(node_id: u8) -> #stack::config::NodeConfig {
+                node_config(node_id)
+            }
         }
 
         impl<A: #stack::od::AppObjects> #stack::od::EntryAccess for Od<A> {
@@ -354,6 +436,31 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
             fn app(&mut self) -> &mut A {
                 &mut self.app
             }
+        }
+    }
+}
+
+/// `NodeConfig` from the spec's `node:` section: only what differs from plain CiA 301.
+fn node_config(d: &Device, stack: &TokenStream) -> TokenStream {
+    let n = &d.node;
+    let object = |o: Option<u16>| match o {
+        Some(i) => {
+            let i = crate::hex(i.into(), 4);
+            quote!(Some(#i))
+        }
+        None => quote!(None),
+    };
+    let (restart, bootup, startup) = (object(n.restart_time_object), object(n.bootup_object), object(n.startup_object));
+    let (deadlines, combine, auto_save) = (n.rpdo_deadline_monitoring, n.combine_emcy_codes, n.auto_save);
+    quote! {
+        #stack::config::NodeConfig {
+            restart_time_object: #restart,
+            bootup_object: #bootup,
+            startup_object: #startup,
+            rpdo_deadlines: #deadlines,
+            combine_emcy_codes: #combine,
+            auto_save: #auto_save,
+            ..#stack::config::NodeConfig::new(node_id)
         }
     }
 }

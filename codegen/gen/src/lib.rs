@@ -64,7 +64,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
     let profile = dec(id.profile.into());
     let od = entries::od_module(device, &modes, options);
     let pdo = pdos::pdo_module(device, &modes, options);
-    let dictionary = dictionary::dictionary(device, options);
+    let dictionary = dictionary::dictionary(device, &modes, options);
     let serial = serial::serial_module(device, options);
     let emcy = emcy::emcy_module(device, &modes, options);
     let hardware = hardware::hardware_module(device);

@@ -2,6 +2,9 @@
 //!
 //! - [`od`]: the object dictionary interface the `device!` macro implements, entry metadata,
 //!   the access checks of both sides (bus and serial host) and the CiA 301 SDO abort codes;
+//! - [`device`]: the contract between a device and whatever runs it (boards, the simulator,
+//!   the size probe, tests);
+//! - [`config`]: how a device's node differs from plain CiA 301 (generated from the spec);
 //! - [`frame`]: the CAN frame exchanged with the board (an `embedded-can` frame);
 //! - [`sdo`]: the SDO server (expedited, segmented and block transfer);
 //! - [`slcan`]: the Lawicel ASCII codec, for boards that act as an SLCAN adapter of their own
@@ -16,6 +19,8 @@
 #![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
 #![cfg_attr(test, allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
+pub mod config;
+pub mod device;
 pub mod emcy;
 pub mod frame;
 pub mod guarding;

@@ -5,8 +5,3 @@
 #![deny(warnings)]
 
 coforge_macros::device!("../../../spec/canopenia.yaml");
-
-/// The CANopen node's settings: plain CiA 301.
-pub const fn node_config(node_id: u8) -> coforge_stack::node::NodeConfig {
-    coforge_stack::node::NodeConfig::new(node_id)
-}

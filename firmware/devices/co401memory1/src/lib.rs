@@ -27,17 +27,3 @@ pub mod supply;
 pub use board::{Board, Config, ConfigError, FixedBoard, StatusOutputs};
 pub use device::Memory1;
 pub use memory::{BANK_SIZE, BLOCK, BLOCKS, Banks, MemoryApp};
-
-/// The CANopen node's settings beyond CiA 301: the frenzel+berg bus-off restart time (2180h),
-/// CO40xx emergency codes combined with OR, and no RPDO deadline monitoring (erratum MEM-27:
-/// a DS301 4.0 device, the RPDO event timer has no function). (2110h is this module's "CiA Compatibility
-/// Test" without function, not the CO401GW1's boot-up switch: the boot-up message is always
-/// sent.)
-pub const fn node_config(node_id: u8) -> coforge_stack::node::NodeConfig {
-    coforge_stack::node::NodeConfig {
-        restart_time_object: Some(0x2180),
-        combine_emcy_codes: true,
-        rpdo_deadlines: false,
-        ..coforge_stack::node::NodeConfig::new(node_id)
-    }
-}

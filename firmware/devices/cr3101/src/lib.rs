@@ -5,9 +5,3 @@
 #![deny(warnings)]
 
 coforge_macros::device!("../../../spec/cr3101.yaml");
-
-/// The CANopen node's settings beyond CiA 301: start-up mode 20F4h, and every parameter
-/// saved as soon as it is written ("saved automatically").
-pub const fn node_config(node_id: u8) -> coforge_stack::node::NodeConfig {
-    coforge_stack::node::NodeConfig { startup_object: Some(0x20F4), auto_save: true, ..coforge_stack::node::NodeConfig::new(node_id) }
-}

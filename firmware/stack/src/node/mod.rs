@@ -33,6 +33,8 @@ use crate::sdo::SdoServer;
 use crate::store::ParamStore;
 use heapless::{Deque, Vec};
 
+pub use crate::config::NodeConfig;
+
 /// Reads an integer entry (up to 4 bytes, little-endian) without access checks.
 pub fn read_u32(od: &mut impl EntryAccess, index: u16, sub: u8) -> Option<u32> {
     let mut buf = [0_u8; 4];
@@ -43,46 +45,6 @@ pub fn read_u32(od: &mut impl EntryAccess, index: u16, sub: u8) -> Option<u32> {
 /// Up to 4 little-endian bytes as a number (shorter values zero-extended).
 pub(crate) fn le_u32(data: &[u8]) -> u32 {
     data.iter().take(4).rev().fold(0, |acc, &b| acc << 8 | u32::from(b))
-}
-
-/// How a device's node differs from a plain CiA 301 slave.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct NodeConfig {
-    /// 1..=127.
-    pub node_id: u8,
-    /// SDO server timeout.
-    pub sdo_timeout_us: u64,
-    /// An object whose value 1 makes the node enter Operational by itself after boot-up
-    /// (CR3101 20F4h "CANopen StartUp mode").
-    pub startup_object: Option<u16>,
-    /// Save every persistent entry as soon as it is written (CR3101: "all parameters are
-    /// saved automatically").
-    pub auto_save: bool,
-    /// An object holding the bus-off restart time in ms, 0 = no automatic restart
-    /// (frenzel+berg 2180h "CAN Restart Time").
-    pub restart_time_object: Option<u16>,
-    /// An object whose value 0 suppresses the boot-up message (frenzel+berg 2110h).
-    pub bootup_object: Option<u16>,
-    /// Emergency bytes 3..7 carry the OR of every active error's manufacturer bytes.
-    pub combine_emcy_codes: bool,
-    /// An RPDO's event timer (14xxh.5) is a deadline monitor (CiA 301 4.2, EMCY 8250h). Off
-    /// for DS301 4.0 devices, where the entry exists but has no function for RPDOs.
-    pub rpdo_deadlines: bool,
-}
-
-impl NodeConfig {
-    pub const fn new(node_id: u8) -> Self {
-        NodeConfig {
-            node_id,
-            sdo_timeout_us: 1_000_000,
-            startup_object: None,
-            auto_save: false,
-            restart_time_object: None,
-            bootup_object: None,
-            combine_emcy_codes: false,
-            rpdo_deadlines: true,
-        }
-    }
 }
 
 /// The CAN controller's error state, as the board reports it.
@@ -120,7 +82,10 @@ pub struct Core<D, S, const P: usize> {
     node_id: u8,
     pending_node_id: Option<u8>,
     state: NmtState,
-    started: bool,
+    /// Powered on: the dictionary holds its defaults and stored parameters.
+    powered: bool,
+    /// The CAN side runs: frames are received and sent (CO401GW1's host enables it).
+    can_enabled: bool,
     now_us: u64,
     tx: Deque<CanFrame, TX_QUEUE>,
     events: Deque<NodeEvent, EVENTS>,
@@ -170,7 +135,8 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
             cfg,
             pending_node_id: None,
             state: NmtState::PreOperational,
-            started: false,
+            powered: false,
+            can_enabled: false,
             now_us: 0,
             tx: Deque::new(),
             events: Deque::new(),
@@ -196,18 +162,51 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
         Node { core, sdo }
     }
 
-    /// Power-on: Initialisation with stored parameters, boot-up message, then
-    /// Pre-operational (or Operational if the start-up object says so).
+    /// Power-on with the CAN side enabled at once (every device but CO401GW1): Initialisation
+    /// with stored parameters, boot-up message, then Pre-operational (or Operational if the
+    /// start-up object says so).
     pub fn start(&mut self, now_us: u64) {
+        self.power_on(now_us);
+        let mode = self.core.od.mode();
+        self.enable_can(mode, now_us);
+    }
+
+    /// Power-on with the CAN side still off: the spec defaults and the stored parameters are
+    /// loaded, and nothing is received or sent until [`Node::enable_can`]. Meanwhile the
+    /// serial host may configure the node, and entries writable by the host only "before the
+    /// CAN interface is enabled" accept its writes.
+    pub fn power_on(&mut self, now_us: u64) {
         self.core.now_us = now_us;
-        self.core.started = true;
-        self.core.initialise(Area::ALL, now_us);
+        self.core.powered = true;
+        self.core.can_enabled = false;
+        self.core.load_parameters(Area::ALL);
+    }
+
+    /// Enables the CAN side in `mode` (the mode may be chosen only now, as CO401GW1's enable
+    /// command does): entries whose default depends on the mode take `mode`'s default, what
+    /// was written before is kept, then boot-up. Ignored before [`Node::power_on`] and once
+    /// enabled (only a power-on disables the CAN side again).
+    pub fn enable_can(&mut self, mode: D::Mode, now_us: u64) {
+        self.core.now_us = now_us;
+        if !self.core.powered || self.core.can_enabled {
+            return;
+        }
+        if mode != self.core.od.mode() {
+            self.core.od.set_mode(mode, self.core.node_id);
+        }
+        self.core.can_enabled = true;
+        self.core.boot(now_us);
+    }
+
+    /// Whether the CAN side runs.
+    pub fn can_enabled(&self) -> bool {
+        self.core.can_enabled
     }
 
     /// A frame received from the bus.
     pub fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
         self.core.now_us = now_us;
-        if !self.core.started {
+        if !self.core.can_enabled {
             return;
         }
         let sdo_rx = 0x600 + u16::from(self.core.node_id);
@@ -234,7 +233,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
     /// Runs the timers and returns the next frame to send, if any. Call until `None`.
     pub fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
         self.core.now_us = now_us;
-        if !self.core.started {
+        if !self.core.can_enabled {
             return None;
         }
         // A bus-off controller cannot send: frames wait in the queue for the restart.
@@ -352,7 +351,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
 
 impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     fn ctx(&self) -> AccessContext {
-        AccessContext { nmt: self.state, can_enabled: true }
+        AccessContext { nmt: self.state, can_enabled: self.can_enabled }
     }
 
     fn send(&mut self, id: u16, data: &[u8]) {
@@ -392,14 +391,26 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
     }
 
-    /// Initialisation after power-on or an NMT reset of `area`.
+    /// Initialisation after an NMT reset of `area`.
     fn initialise(&mut self, area: Area, now_us: u64) {
+        self.load_parameters(area);
+        self.boot(now_us);
+    }
+
+    /// The node-ID set for the next reset, then the spec defaults of `area` and its stored
+    /// parameters.
+    fn load_parameters(&mut self, area: Area) {
         if let Some(id) = self.pending_node_id.take() {
             self.node_id = id;
         }
         self.od.reset_area(area, self.node_id);
         // A store that cannot be read leaves the defaults: the node must still boot.
         let _ = self.store.load(&mut self.od, area);
+    }
+
+    /// The communication side starts afresh: services from the dictionary, boot-up message,
+    /// Pre-operational (or Operational, as the start-up object says).
+    fn boot(&mut self, now_us: u64) {
         self.emcy.reset();
         self.rpdo_length_error = false;
         self.tx.clear();

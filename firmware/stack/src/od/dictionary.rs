@@ -117,8 +117,15 @@ impl CommObjects {
 }
 
 /// What a node needs from a generated dictionary besides reads and writes: the spec
-/// defaults, the persistent block and the emergencies.
+/// defaults, the operating mode, the node settings, the persistent block and the
+/// emergencies.
 pub trait NodeDictionary: EntryAccess {
+    /// The device's operating modes (the generated `Mode`).
+    type Mode: Copy + PartialEq + core::fmt::Debug + 'static;
+
+    /// Every mode, the spec's first (the default) first.
+    const MODES: &'static [Self::Mode];
+
     /// Bytes of the persistent block (every `storage: persistent` entry, index order).
     const PERSISTENT_SIZE: usize;
 
@@ -142,6 +149,37 @@ pub trait NodeDictionary: EntryAccess {
 
     /// The spec's emergencies in the dictionary's mode.
     fn emergencies(&self) -> &'static [crate::emcy::EmcyDefault];
+
+    /// The dictionary with the spec's defaults of `mode`, `$NODEID` resolved for `node_id`.
+    fn new(mode: Self::Mode, node_id: u8, app: Self::App) -> Self
+    where
+        Self: Sized;
+
+    /// The mode the dictionary is in: its entry table and emergencies.
+    fn mode(&self) -> Self::Mode;
+
+    /// Switches to `mode`. Entries whose spec default differs between modes take `mode`'s
+    /// default; every other value is kept (what a host configured before the CAN side was
+    /// enabled survives the mode chosen at enable).
+    fn set_mode(&mut self, mode: Self::Mode, node_id: u8);
+
+    /// The mode's name in the spec.
+    fn mode_name(mode: Self::Mode) -> &'static str
+    where
+        Self: Sized;
+
+    /// The node settings of the spec's `node:` section, for `node_id`.
+    fn node_config(node_id: u8) -> crate::config::NodeConfig
+    where
+        Self: Sized;
+}
+
+/// The mode a host tool names (`None`: the spec's first), or the list of known names.
+pub fn mode_named<D: NodeDictionary>(name: Option<&str>) -> Result<D::Mode, &'static [D::Mode]> {
+    match name {
+        None => D::MODES.first().copied().ok_or(D::MODES),
+        Some(name) => D::MODES.iter().copied().find(|&m| D::mode_name(m) == name).ok_or(D::MODES),
+    }
 }
 
 /// Objects whose data the device keeps outside the dictionary (EEPROM banks, a memory card):
