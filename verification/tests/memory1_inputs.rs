@@ -6,6 +6,7 @@
 //! the bank sums as they were.
 
 use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
+use coforge_stack::device::{Device, HostPort};
 use coforge_stack::frame::CanFrame;
 use coforge_storage::ram::RamEeprom;
 use proptest::prelude::*;
@@ -70,7 +71,8 @@ proptest! {
             match input {
                 Input::Serial { byte, gap_ms } => {
                     now_ms += gap_ms;
-                    let n = dev.on_serial_byte(byte, now_ms, &mut out);
+                    dev.on_host_byte(byte, u64::from(now_ms) * 1000);
+                    let n = dev.host_output(u64::from(now_ms) * 1000, &mut out);
                     prop_assert!(n <= out.len());
                 }
                 Input::Can { id, rtr, data } => {

@@ -29,6 +29,83 @@ pub fn elapsed(earlier: Millis, later: Millis) -> u32 {
     later.wrapping_sub(earlier)
 }
 
+/// The millisecond clock of a framing, kept from the microsecond times the device contract
+/// hands over, without a 64-bit division (one costs a Cortex-M0 about 1 KiB of flash): it
+/// counts the whole milliseconds between calls and carries the rest.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct MillisClock {
+    last_us: u64,
+    ms: Millis,
+    carry_us: u32,
+}
+
+impl MillisClock {
+    /// The clock at `now_us` (times never run backwards; an earlier time reads as no time).
+    pub fn at(&mut self, now_us: u64) -> Millis {
+        let step = now_us.saturating_sub(self.last_us);
+        self.last_us = self.last_us.max(now_us);
+        // A step beyond 71 minutes only needs to read as long: the framings compare pauses
+        // of milliseconds.
+        let step = u32::try_from(step).unwrap_or(u32::MAX / 2).saturating_add(self.carry_us);
+        self.ms = self.ms.wrapping_add(step / 1000);
+        self.carry_us = step % 1000;
+        self.ms
+    }
+}
+
+/// Bytes waiting for the host: answers are encoded into it and handed out whenever the
+/// runtime asks, so a device can also answer late or unasked.
+#[derive(Debug, Clone)]
+pub struct Outbox<const N: usize> {
+    bytes: [u8; N],
+    start: usize,
+    end: usize,
+    /// Frames dropped because the runtime did not take the earlier ones.
+    pub overflows: u32,
+}
+
+impl<const N: usize> Default for Outbox<N> {
+    fn default() -> Self {
+        Outbox { bytes: [0; N], start: 0, end: 0, overflows: 0 }
+    }
+}
+
+impl<const N: usize> Outbox<N> {
+    /// Appends one frame that `encode` writes into the free space (returning its length, or
+    /// `None` if it does not fit); a frame that does not fit is dropped whole and counted.
+    pub fn push_with(&mut self, encode: impl FnOnce(&mut [u8]) -> Option<usize>) -> bool {
+        if self.start == self.end {
+            (self.start, self.end) = (0, 0);
+        }
+        let written = self.bytes.get_mut(self.end..).and_then(encode);
+        match written {
+            Some(n) if self.end + n <= N => {
+                self.end += n;
+                true
+            }
+            _ => {
+                self.overflows = self.overflows.wrapping_add(1);
+                false
+            }
+        }
+    }
+
+    /// Moves waiting bytes into `out`; returns how many.
+    pub fn take(&mut self, out: &mut [u8]) -> usize {
+        let waiting = self.bytes.get(self.start..self.end).unwrap_or(&[]);
+        let n = waiting.len().min(out.len());
+        if let (Some(dst), Some(src)) = (out.get_mut(..n), waiting.get(..n)) {
+            dst.copy_from_slice(src);
+        }
+        self.start += n;
+        n
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.start == self.end
+    }
+}
+
 /// A decoded frame, borrowed from the decoder's buffer until the next byte is pushed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Frame<'a> {
@@ -90,3 +167,41 @@ type Decoded = core::result::Result<(u8, Option<u8>, std::vec::Vec<u8>), FrameEr
 
 #[cfg(test)]
 extern crate std;
+
+#[cfg(test)]
+mod clock_tests {
+    use super::*;
+
+    #[test]
+    fn millis_follow_microseconds_without_drift() {
+        let mut c = MillisClock::default();
+        assert_eq!(c.at(999), 0);
+        assert_eq!(c.at(1_000), 1);
+        assert_eq!(c.at(2_500), 2);
+        assert_eq!(c.at(3_499), 3, "the carried 500 us count");
+        // 10 000 steps of 1.7 ms read as 17 000 ms: nothing lost to rounding.
+        let mut now = 3_499;
+        for _ in 0..10_000 {
+            now += 1_700;
+        }
+        assert_eq!(c.at(now), 3 + 17_000);
+        assert_eq!(c.at(now - 5_000), 3 + 17_000, "an earlier time reads as no time");
+        assert!(elapsed(17_003, c.at(now + 5_000_000_000)) >= 1_000_000, "a 83-minute gap reads as long");
+    }
+
+    #[test]
+    fn the_outbox_keeps_frames_whole_and_in_order() {
+        let mut o = Outbox::<6>::default();
+        assert!(o.push_with(|b| b.get_mut(..3).map(|d| d.copy_from_slice(&[1, 2, 3])).map(|()| 3)));
+        assert!(!o.push_with(|b| b.get_mut(..4).map(|_| 4)), "no room for 4 more: dropped whole");
+        assert_eq!(o.overflows, 1);
+        let mut out = [0; 2];
+        assert_eq!(o.take(&mut out), 2);
+        assert_eq!(out, [1, 2]);
+        assert_eq!(o.take(&mut out), 1);
+        assert_eq!(out[0], 3);
+        assert!(o.is_empty());
+        assert!(o.push_with(|b| b.get_mut(..6).map(|_| 6)), "emptied: the whole buffer is free again");
+        assert_eq!(o.take(&mut [0; 8]), 6);
+    }
+}

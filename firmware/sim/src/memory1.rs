@@ -4,6 +4,7 @@
 use crate::devices::{SimNode, StoreAt, eeprom};
 use crate::storage::MemStorage;
 use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
+use coforge_stack::device::{Device, HostPort};
 use coforge_stack::frame::CanFrame;
 use coforge_stack::node::{BusState, NodeEvent};
 use coforge_stack::od::{ReadLen, SdoAbort, Side};
@@ -24,13 +25,13 @@ pub fn build(mode: Option<&str>, node_id: u8, store: &StoreAt) -> Result<Box<dyn
 
 impl SimNode for SimMemory1 {
     fn start(&mut self, now_us: u64) {
-        Memory1::start(self, now_us);
+        Device::start(self, now_us);
     }
     fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
-        Memory1::on_frame(self, frame, now_us);
+        Device::on_frame(self, frame, now_us);
     }
     fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
-        Memory1::poll(self, now_us)
+        Device::poll(self, now_us)
     }
     fn state(&self) -> coforge_stack::nmt::NmtState {
         Memory1::state(self)
@@ -53,10 +54,10 @@ impl SimNode for SimMemory1 {
         found.map(|e| self.node_mut().clear(&e)).is_some()
     }
     fn on_bus_state(&mut self, bus: BusState, now_us: u64) {
-        Memory1::on_bus_state(self, bus, now_us);
+        Device::on_bus_state(self, bus, now_us);
     }
     fn take_event(&mut self) -> Option<NodeEvent> {
-        Memory1::take_event(self)
+        Device::take_event(self)
     }
     fn trigger_tpdo(&mut self, number: u16) {
         self.node_mut().trigger_tpdo(number);
@@ -68,7 +69,9 @@ impl SimNode for SimMemory1 {
         true
     }
     fn serial_byte(&mut self, byte: u8, now_ms: u32, out: &mut [u8]) -> usize {
-        self.on_serial_byte(byte, now_ms, out)
+        let now_us = u64::from(now_ms) * 1000;
+        self.on_host_byte(byte, now_us);
+        self.host_output(now_us, out)
     }
     fn control(&mut self, command: &str) -> Result<String, String> {
         let words: Vec<&str> = command.split_whitespace().collect();

@@ -1,13 +1,16 @@
 //! The whole module: the CANopen node over the memory objects, the serial host, the CAN
 //! monitoring channel and the supply guard, kept consistent after every input.
 
-use crate::board::{Board, Config, ConfigError, StatusOutputs};
+use crate::board::{Board, Config, ConfigError, FixedBoard, StatusOutputs};
+use crate::memory::BANK_SIZE;
 use crate::memory::MemoryApp;
 use crate::monitor::{Monitor, monitored_id};
 use crate::supply::Supply;
 use crate::{Mode, Node, Od, emcy, node_config, serial};
-use coforge_link::{Deframer, Millis};
+use coforge_link::{Deframer, MillisClock, Outbox};
+use coforge_stack::device::{Assemble, AssembleError, Device, HostPort, MemoryRequest, NodeAccess};
 use coforge_stack::frame::CanFrame;
+use coforge_stack::leds::Leds;
 use coforge_stack::nmt::NmtState;
 use coforge_stack::node::{BusState, NodeEvent};
 use coforge_stack::store::NoStore;
@@ -19,6 +22,8 @@ use heapless::Deque;
 const SCRUB_PERIOD_US: u64 = 1_000_000;
 /// Frames the serial host asked to transmit that wait for the bus.
 const RAW_TX: usize = 4;
+/// Answer bytes waiting for the host: the longest answer (11 bytes) and some.
+const HOST_OUT: usize = 24;
 
 /// The CO401Memory1 module on banks of type `S` and board `B`.
 #[derive(Debug)]
@@ -27,6 +32,8 @@ pub struct Memory1<S, B> {
     pub(crate) board: B,
     config: Config,
     host: serial::Decoder,
+    host_clock: MillisClock,
+    pub(crate) host_out: Outbox<HOST_OUT>,
     pub(crate) monitor: Monitor,
     pub(crate) supply: Supply,
     pub(crate) raw_tx: Deque<CanFrame, RAW_TX>,
@@ -54,6 +61,8 @@ impl<S: Storage, B: Board> Memory1<S, B> {
             board,
             config,
             host: serial::decoder(),
+            host_clock: MillisClock::default(),
+            host_out: Outbox::default(),
             monitor: Monitor::default(),
             supply: Supply::Normal,
             raw_tx: Deque::new(),
@@ -65,92 +74,6 @@ impl<S: Storage, B: Board> Memory1<S, B> {
             next_scrub_us: SCRUB_PERIOD_US,
             host_rejects: 0,
         })
-    }
-
-    /// Power-on: boot-up message, then pre-operational.
-    pub fn start(&mut self, now_us: u64) {
-        self.node.start(now_us);
-        self.sample_supply();
-        self.update(true);
-    }
-
-    /// A frame from the bus. Frames on the monitored identifier go to the monitoring channel.
-    pub fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
-        // The frame may write the memory: the guard must know the supply of this moment.
-        self.sample_supply();
-        let monitored = monitored_id(self.node.od().rpdo2_comm.cob_id_used_by_rpdo);
-        if monitored == Some(frame.id) && !frame.rtr {
-            self.monitor.capture(frame.payload());
-            let od = self.node.od_mut();
-            od.can_monitoring_byte.items = [0; 8];
-            for (dst, &b) in od.can_monitoring_byte.items.iter_mut().zip(frame.payload()) {
-                *dst = b;
-            }
-        } else {
-            self.node.on_frame(frame, now_us);
-        }
-        self.update(false);
-    }
-
-    /// Runs the timers, the supply guard and the scrub; returns the next frame to send.
-    pub fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
-        let scrub = now_us >= self.next_scrub_us;
-        if scrub {
-            self.next_scrub_us = now_us.saturating_add(SCRUB_PERIOD_US);
-            // A lost block shows in the bank status, which the update below reports.
-            let _ = self.node.od_mut().app.banks_mut().scrub_next();
-        }
-        // Every other input updates after itself; here only the supply can have moved, and
-        // sampling it once a millisecond is plenty (it falls over milliseconds, not cycles).
-        // (No division: a 64-bit one costs a Cortex-M0 1 KiB of flash.)
-        if scrub || now_us >= self.next_sample_us {
-            self.next_sample_us = now_us.saturating_add(1000);
-            self.sample_supply();
-            self.update(false);
-        }
-        if !self.bus_off
-            && let Some(frame) = self.raw_tx.pop_front()
-        {
-            return Some(frame);
-        }
-        self.node.poll(now_us)
-    }
-
-    /// One byte from the serial host at `now_ms`; writes the answer, if the byte completes a
-    /// command, into `out` and returns its length (0: nothing to send).
-    pub fn on_serial_byte(&mut self, byte: u8, now_ms: Millis, out: &mut [u8]) -> usize {
-        let mut data = [0_u8; coforge_link::nibble::MAX_DATA];
-        let (code, len) = match self.host.push(byte, now_ms) {
-            None => return 0,
-            Some(Err(_)) => {
-                self.host_rejects = self.host_rejects.wrapping_add(1);
-                return 0;
-            }
-            Some(Ok(frame)) => {
-                let n = frame.data.len().min(data.len());
-                if let (Some(dst), Some(src)) = (data.get_mut(..n), frame.data.get(..n)) {
-                    dst.copy_from_slice(src);
-                }
-                (frame.code, n)
-            }
-        };
-        let frame = coforge_link::Frame { code, length_code: None, network: None, data: data.get(..len).unwrap_or(&[]) };
-        self.sample_supply();
-        let n = self.answer(&frame, out);
-        self.update(false);
-        n
-    }
-
-    /// The CAN controller's error state changed.
-    pub fn on_bus_state(&mut self, bus: BusState, now_us: u64) {
-        self.bus_off = bus == BusState::BusOff;
-        self.node.on_bus_state(bus, now_us);
-        self.sample_supply();
-        self.update(false);
-    }
-
-    pub fn take_event(&mut self) -> Option<NodeEvent> {
-        self.node.take_event()
     }
 
     /// Serial frames dropped: cut short by a pause, or not a command of the protocol.
@@ -168,6 +91,11 @@ impl<S: Storage, B: Board> Memory1<S, B> {
 
     pub fn state(&self) -> NmtState {
         self.node.state()
+    }
+
+    /// Answers that could not wait for the host (it never took the earlier ones).
+    pub fn host_overflows(&self) -> u32 {
+        self.host_out.overflows
     }
 
     pub fn node(&self) -> &Node<MemoryApp<S>, NoStore> {
@@ -229,5 +157,134 @@ impl<S: Storage, B: Board> Memory1<S, B> {
             self.outputs = outputs;
             self.board.set_outputs(outputs);
         }
+    }
+}
+
+impl<S: Storage, B: Board> Device for Memory1<S, B> {
+    /// Power-on: boot-up message, then pre-operational.
+    fn start(&mut self, now_us: u64) {
+        self.node.start(now_us);
+        self.sample_supply();
+        self.update(true);
+    }
+
+    /// A frame from the bus. Frames on the monitored identifier go to the monitoring channel.
+    fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
+        // The frame may write the memory: the guard must know the supply of this moment.
+        self.sample_supply();
+        let monitored = monitored_id(self.node.od().rpdo2_comm.cob_id_used_by_rpdo);
+        if monitored == Some(frame.id) && !frame.rtr {
+            self.monitor.capture(frame.payload());
+            let od = self.node.od_mut();
+            od.can_monitoring_byte.items = [0; 8];
+            for (dst, &b) in od.can_monitoring_byte.items.iter_mut().zip(frame.payload()) {
+                *dst = b;
+            }
+        } else {
+            self.node.on_frame(frame, now_us);
+        }
+        self.update(false);
+    }
+
+    /// Runs the timers, the supply guard and the scrub; returns the next frame to send.
+    fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
+        let scrub = now_us >= self.next_scrub_us;
+        if scrub {
+            self.next_scrub_us = now_us.saturating_add(SCRUB_PERIOD_US);
+            // A lost block shows in the bank status, which the update below reports.
+            let _ = self.node.od_mut().app.banks_mut().scrub_next();
+        }
+        // Every other input updates after itself; here only the supply can have moved, and
+        // sampling it once a millisecond is plenty (it falls over milliseconds, not cycles).
+        // (No division: a 64-bit one costs a Cortex-M0 1 KiB of flash.)
+        if scrub || now_us >= self.next_sample_us {
+            self.next_sample_us = now_us.saturating_add(1000);
+            self.sample_supply();
+            self.update(false);
+        }
+        if !self.bus_off
+            && let Some(frame) = self.raw_tx.pop_front()
+        {
+            return Some(frame);
+        }
+        self.node.poll(now_us)
+    }
+
+    /// The CAN controller's error state changed.
+    fn on_bus_state(&mut self, bus: BusState, now_us: u64) {
+        self.bus_off = bus == BusState::BusOff;
+        self.node.on_bus_state(bus, now_us);
+        self.sample_supply();
+        self.update(false);
+    }
+
+    fn take_event(&mut self) -> Option<NodeEvent> {
+        self.node.take_event()
+    }
+
+    fn leds(&self) -> Leds {
+        self.node.leds()
+    }
+
+    fn node(&self) -> &dyn NodeAccess {
+        &self.node
+    }
+
+    fn node_mut(&mut self) -> &mut dyn NodeAccess {
+        &mut self.node
+    }
+
+    fn host_port(&mut self) -> Option<&mut dyn HostPort> {
+        Some(self)
+    }
+}
+
+/// The RS232 host interface: one answer per command, queued until the runtime sends it.
+impl<S: Storage, B: Board> HostPort for Memory1<S, B> {
+    fn on_host_byte(&mut self, byte: u8, now_us: u64) {
+        let now_ms = self.host_clock.at(now_us);
+        let mut data = [0_u8; coforge_link::nibble::MAX_DATA];
+        let (code, len) = match self.host.push(byte, now_ms) {
+            None => return,
+            Some(Err(_)) => {
+                self.host_rejects = self.host_rejects.wrapping_add(1);
+                return;
+            }
+            Some(Ok(frame)) => {
+                let n = frame.data.len().min(data.len());
+                if let (Some(dst), Some(src)) = (data.get_mut(..n), frame.data.get(..n)) {
+                    dst.copy_from_slice(src);
+                }
+                (frame.code, n)
+            }
+        };
+        let frame = coforge_link::Frame { code, length_code: None, network: None, data: data.get(..len).unwrap_or(&[]) };
+        self.sample_supply();
+        self.answer(&frame);
+        self.update(false);
+    }
+
+    fn host_output(&mut self, _now_us: u64, out: &mut [u8]) -> usize {
+        self.host_out.take(out)
+    }
+}
+
+/// The module on a [`FixedBoard`] whose pins give `node_id`, with its two banks from the
+/// runtime (the simulator's EEPROM images).
+impl<S: Storage> Assemble<S> for Memory1<S, FixedBoard> {
+    fn mode_names(f: &mut dyn FnMut(&'static str)) {
+        f(Mode::Default.name());
+    }
+
+    fn assemble(mode: Option<&str>, node_id: u8, memory: &mut dyn FnMut(MemoryRequest) -> Option<S>) -> Result<Self, AssembleError> {
+        if mode.is_some_and(|m| m != Mode::Default.name()) {
+            return Err(AssembleError::UnknownMode);
+        }
+        if !(1..=127).contains(&node_id) {
+            return Err(AssembleError::NodeId);
+        }
+        let mut bank = |name| memory(MemoryRequest { name, capacity: BANK_SIZE }).ok_or(AssembleError::NoMemory(name));
+        let banks = [bank("bank1")?, bank("bank2")?];
+        Memory1::new(banks, FixedBoard::new(node_id)).map_err(|_| AssembleError::Config("reserved configuration pins"))
     }
 }

@@ -33,20 +33,19 @@ fn negative(code: u8) -> Option<DeviceToHost<'static>> {
 }
 
 impl<S: Storage, B: Board> Memory1<S, B> {
-    /// Executes one frame from the host and encodes the answer into `out`; returns its length.
-    pub(crate) fn answer(&mut self, frame: &Frame<'_>, out: &mut [u8]) -> usize {
+    /// Executes one frame from the host and queues the answer for it.
+    pub(crate) fn answer(&mut self, frame: &Frame<'_>) {
         let mut can_data = [0_u8; 8];
         let answer = match HostToDevice::decode(frame) {
             Ok(command) => self.execute(command, &mut can_data),
             Err(DecodeError::Length { .. }) => negative(frame.code),
             Err(_) => None,
         };
-        match answer.map(|a| a.encode(out)) {
-            Some(Ok(n)) => n,
-            _ => {
-                self.host_rejects = self.host_rejects.wrapping_add(1);
-                0
+        match answer {
+            Some(a) => {
+                self.host_out.push_with(|out| a.encode(out).ok());
             }
+            None => self.host_rejects = self.host_rejects.wrapping_add(1),
         }
     }
 

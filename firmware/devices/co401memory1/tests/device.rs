@@ -4,6 +4,7 @@
 //! emergencies, the supply guard and CAN monitoring.
 
 use co401memory1::{BANK_SIZE, ConfigError, FixedBoard, Memory1};
+use coforge_stack::device::{Device, HostPort};
 use coforge_stack::frame::CanFrame;
 use coforge_storage::ram::RamEeprom;
 
@@ -92,7 +93,8 @@ impl Rig {
         for &b in bytes {
             self.now_us += 1_000;
             let mut out = [0; 16];
-            let n = self.dev.on_serial_byte(b, (self.now_us / 1000) as u32, &mut out);
+            self.dev.on_host_byte(b, self.now_us);
+            let n = self.dev.host_output(self.now_us, &mut out);
             answer.extend_from_slice(&out[..n]);
         }
         self.run(1_000);
