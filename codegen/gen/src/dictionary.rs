@@ -63,7 +63,7 @@ fn slots(d: &Device) -> Vec<Slot<'_>> {
 }
 
 /// The Rust type of an entry's field.
-fn rust_type(e: &Entry, stack: &TokenStream) -> TokenStream {
+pub(crate) fn rust_type(e: &Entry, stack: &TokenStream) -> TokenStream {
     match e.data_type {
         DataType::Boolean => quote!(bool),
         DataType::Unsigned8 => quote!(u8),

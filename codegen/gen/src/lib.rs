@@ -10,16 +10,21 @@
 //!   every mapping fits a CAN frame;
 //! - `Od<A>`: the typed dictionary and its `EntryAccess`/`NodeDictionary` dispatch;
 //! - `emcy::*`: the spec's emergencies; `serial::*`: the host protocol's codecs;
+//! - `index::*`: every object's index by name; `app::Hooks`: one typed hook per app-backed
+//!   object (group), routed by `app::Typed<H>`;
+//! - `node_config`: the node settings of the spec's `node:` section;
 //! - `hardware::*`: decoders of the configuration pins (node-ID, bit rates, configuration);
 //! - identity constants and the `Node<A, S>` alias.
 //!
 //! [`EntryInfo`]: https://docs.rs/coforge-stack
 #![forbid(unsafe_code)]
 
+mod app;
 mod dictionary;
 mod emcy;
 mod entries;
 mod hardware;
+mod index;
 mod modes;
 mod naming;
 mod pdos;
@@ -68,6 +73,8 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
     let serial = serial::serial_module(device, options);
     let emcy = emcy::emcy_module(device, &modes, options);
     let hardware = hardware::hardware_module(device);
+    let index = index::index_module(device);
+    let app = app::app_module(device, options);
     let stack = &options.stack;
     quote! {
         /// Device name from the spec.
@@ -84,6 +91,8 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
         #emcy
         #serial
         #hardware
+        #index
+        #app
 
         /// The device's CANopen node: its dictionary, parameter store `S` and app objects `A`.
         pub type Node<A, S> = #stack::node::Node<Od<A>, S, { od::MAX_WRITE_SIZE }, { pdo::SLOTS }>;

@@ -1,6 +1,7 @@
 //! The whole module: the CANopen node over the memory objects, the serial host, the CAN
 //! monitoring channel and the supply guard, kept consistent after every input.
 
+use crate::app::Typed;
 use crate::board::{Board, Config, ConfigError, FixedBoard, StatusOutputs};
 use crate::memory::BANK_SIZE;
 use crate::memory::MemoryApp;
@@ -28,7 +29,7 @@ const HOST_OUT: usize = 24;
 /// The CO401Memory1 module on banks of type `S` and board `B`.
 #[derive(Debug)]
 pub struct Memory1<S, B> {
-    pub(crate) node: Node<MemoryApp<S>, NoStore>,
+    pub(crate) node: Node<Typed<MemoryApp<S>>, NoStore>,
     pub(crate) board: B,
     config: Config,
     host: serial::Decoder,
@@ -55,7 +56,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
     /// Reads the configuration pins and mounts the banks (repairing what a power cut left).
     pub fn new(banks: [S; 2], mut board: B) -> Result<Self, ConfigError> {
         let config = Config::read(&mut board)?;
-        let od = Od::new(Mode::Default, config.node_id, MemoryApp::new(banks));
+        let od = Od::new(Mode::Default, config.node_id, Typed(MemoryApp::new(banks)));
         Ok(Memory1 {
             node: Node::new(od, NoStore, node_config(config.node_id)),
             board,
@@ -98,11 +99,11 @@ impl<S: Storage, B: Board> Memory1<S, B> {
         self.host_out.overflows
     }
 
-    pub fn node(&self) -> &Node<MemoryApp<S>, NoStore> {
+    pub fn node(&self) -> &Node<Typed<MemoryApp<S>>, NoStore> {
         &self.node
     }
 
-    pub fn node_mut(&mut self) -> &mut Node<MemoryApp<S>, NoStore> {
+    pub fn node_mut(&mut self) -> &mut Node<Typed<MemoryApp<S>>, NoStore> {
         &mut self.node
     }
 

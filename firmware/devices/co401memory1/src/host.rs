@@ -5,6 +5,7 @@
 
 use crate::board::Board;
 use crate::device::Memory1;
+use crate::index;
 use crate::monitor::monitored_id;
 use crate::serial::{DeviceToHost, HostToDevice};
 use coforge_link::Frame;
@@ -57,7 +58,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
             }
             // ADR 1 = 6200h.1, ADR 2 = 6200h.2 (erratum MEM-23).
             HostToDevice::WriteCommandRegister { register, value } => {
-                let ok = matches!(register, 1 | 2) && self.node.write(0x6200, register, &[value], Side::Device).is_ok();
+                let ok = matches!(register, 1 | 2) && self.node.write(index::WRITE_MEMORY_BANK_COMMAND, register, &[value], Side::Device).is_ok();
                 DeviceToHost::WriteCommandRegisterAck { ack: ack(ok) }
             }
             HostToDevice::ReadMemoryRequest { index, sub } => {
@@ -92,11 +93,11 @@ impl<S: Storage, B: Board> Memory1<S, B> {
         let current = self.node.od().rpdo2_comm.cob_id_used_by_rpdo;
         // CiA 301: a valid COB-ID is invalidated before it changes.
         let invalid = current | 0x8000_0000;
-        if self.node.write(0x1401, 1, &invalid.to_le_bytes(), Side::Device).is_err() {
+        if self.node.write(index::RPDO2_COMM, 1, &invalid.to_le_bytes(), Side::Device).is_err() {
             return false;
         }
         self.monitor.stop();
-        id == 0 || self.node.write(0x1401, 1, &u32::from(id).to_le_bytes(), Side::Device).is_ok()
+        id == 0 || self.node.write(index::RPDO2_COMM, 1, &u32::from(id).to_le_bytes(), Side::Device).is_ok()
     }
 
     /// NMT, SYNC, this node's SDO requests, RPDO1 and node guarding.

@@ -1,7 +1,9 @@
 //! The app-backed objects: memory bytes (5000h..503Fh), bank checksums (5C00h), bank status
-//! (6000h) and bank commands (6200h), all over the mirrored banks.
+//! (6000h) and bank commands (6200h), all over the mirrored banks, each through its generated
+//! hook.
 
-use coforge_stack::od::{AppObjects, EntryInfo, ReadLen, SdoAbort, read_slice};
+use crate::app::Hooks;
+use coforge_stack::od::SdoAbort;
 use coforge_storage::{BankStatus, Error, MirroredBanks};
 use embedded_storage::Storage;
 
@@ -17,8 +19,6 @@ pub type Banks<S> = MirroredBanks<S, BLOCKS, BLOCK>;
 
 /// 6200h command: clear all error flags and status information of the bank's channel.
 pub const CLEAR_STATUS: u8 = 0x91;
-
-const MEMORY: core::ops::RangeInclusive<u16> = 0x5000..=0x503F;
 
 /// The memory module's application objects.
 #[derive(Debug)]
@@ -52,14 +52,6 @@ impl<S: Storage> MemoryApp<S> {
         self.banks.status(bank)
     }
 
-    /// Memory address of `index`/`sub` (sub 1 of 5000h is address 0).
-    fn address(index: u16, sub: u8) -> Option<usize> {
-        if !MEMORY.contains(&index) || !(1..=BLOCK).contains(&usize::from(sub)) {
-            return None;
-        }
-        Some(usize::from(index - 0x5000) * BLOCK + usize::from(sub) - 1)
-    }
-
     /// Bank 0 or 1 for sub-index 1 or 2.
     fn bank(sub: u8) -> Result<usize, SdoAbort> {
         match sub {
@@ -77,44 +69,45 @@ fn abort(e: Error) -> SdoAbort {
     }
 }
 
-impl<S: Storage> AppObjects for MemoryApp<S> {
-    fn read(&mut self, _: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
-        match index {
-            0x5C00 => read_slice(&self.banks.checksum(Self::bank(sub)?).to_le_bytes(), offset, buf),
-            0x6000 => read_slice(&[self.banks.status(Self::bank(sub)?).bits()], offset, buf),
-            0x6200 => read_slice(&[self.commands.get(Self::bank(sub)?).copied().unwrap_or(0)], offset, buf),
-            // Sub 0: the number of bytes in the block.
-            index if MEMORY.contains(&index) && sub == 0 => read_slice(&[BLOCK as u8], offset, buf),
-            index => {
-                let addr = Self::address(index, sub).ok_or(SdoAbort::NoObject)?;
-                let mut byte = [0];
-                self.banks.read(addr, &mut byte).map_err(abort)?;
-                read_slice(&byte, offset, buf)
-            }
-        }
+/// Each app-backed object's reads and writes, as the generated hooks name them.
+impl<S: Storage> Hooks for MemoryApp<S> {
+    fn read_memory_block_byte_access(&mut self, block: u16, sub: u8) -> Result<u8, SdoAbort> {
+        // Sub 0: the number of bytes in the block.
+        let Some(offset) = usize::from(sub).checked_sub(1) else { return Ok(BLOCK as u8) };
+        let mut byte = [0];
+        self.banks.read(usize::from(block) * BLOCK + offset, &mut byte).map_err(abort)?;
+        Ok(byte[0])
     }
 
-    fn write(&mut self, _: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
-        match index {
-            0x6200 => {
-                let bank = Self::bank(sub)?;
-                let &[command] = data else { return Err(SdoAbort::LengthMismatch) };
-                if let Some(c) = self.commands.get_mut(bank) {
-                    *c = command;
-                }
-                // Only 0x91 is defined; other command bytes are kept and do nothing.
-                if command == CLEAR_STATUS {
-                    self.banks.clear_status(bank);
-                }
-                Ok(())
-            }
-            index => {
-                let addr = Self::address(index, sub).ok_or(SdoAbort::NoObject)?;
-                if !self.writes_allowed {
-                    return Err(SdoAbort::DataTransferState);
-                }
-                self.banks.write(addr, data).map_err(abort)
-            }
+    fn write_memory_block_byte_access(&mut self, block: u16, sub: u8, value: u8) -> Result<(), SdoAbort> {
+        let offset = usize::from(sub).checked_sub(1).ok_or(SdoAbort::ReadOnly)?;
+        if !self.writes_allowed {
+            return Err(SdoAbort::DataTransferState);
         }
+        self.banks.write(usize::from(block) * BLOCK + offset, &[value]).map_err(abort)
+    }
+
+    fn read_memory_bank_checksum(&mut self, sub: u8) -> Result<u32, SdoAbort> {
+        Ok(self.banks.checksum(Self::bank(sub)?))
+    }
+
+    fn read_memory_bank_status(&mut self, sub: u8) -> Result<u8, SdoAbort> {
+        Ok(self.banks.status(Self::bank(sub)?).bits())
+    }
+
+    fn read_write_memory_bank_command(&mut self, sub: u8) -> Result<u8, SdoAbort> {
+        Ok(self.commands.get(Self::bank(sub)?).copied().unwrap_or(0))
+    }
+
+    fn write_write_memory_bank_command(&mut self, sub: u8, command: u8) -> Result<(), SdoAbort> {
+        let bank = Self::bank(sub)?;
+        if let Some(c) = self.commands.get_mut(bank) {
+            *c = command;
+        }
+        // Only 0x91 is defined; other command bytes are kept and do nothing.
+        if command == CLEAR_STATUS {
+            self.banks.clear_status(bank);
+        }
+        Ok(())
     }
 }
