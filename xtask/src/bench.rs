@@ -209,7 +209,7 @@ fn instruction_table(c: &Counts) -> String {
 /// Directories holding `benches/*.rs` files that use criterion, with their package names.
 fn criterion_benches() -> Vec<(String, String)> {
     let mut found = Vec::new();
-    for dir in ["codegen/spec", "codegen/gen", "codegen/cli", "firmware/sim", "firmware/stack", "verification"] {
+    for dir in ["codegen/spec", "codegen/gen", "cli", "firmware/sim", "firmware/stack", "verification"] {
         let crate_dir = root().join(dir);
         let Ok(manifest) = std::fs::read_to_string(crate_dir.join("Cargo.toml")) else { continue };
         let Some(package) = manifest.lines().find_map(|l| l.strip_prefix("name = ").map(|n| n.trim_matches('"').to_string())) else { continue };
