@@ -1,4 +1,4 @@
-//! Proof obligations of the mirrored EEPROM banks (`coforge-storage`, issue 5 §3): a power cut
+//! Proof obligations of the mirrored EEPROM banks (`coforge-storage`): a power cut
 //! at any byte of a write or of start-up recovery, any single-byte corruption of either bank,
 //! the incremental bank sums, and totality for arbitrary bank contents.
 //!

@@ -1,4 +1,4 @@
-//! Static RAM of a node: the aim is CO401GW1's whole node (dictionary, every protocol
+//! Static RAM of a node: the aim is CO401GW1's whole node (dictionary, every protocol
 //! engine, SDO buffer, queues) within the 2 KiB of the MCU family the original chip ran on.
 //! Measured on the host, where u64 and pointers are at least as large as on Cortex-M.
 

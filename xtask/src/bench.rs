@@ -20,7 +20,7 @@ const TARGET: &str = "thumbv7m-none-eabi";
 const IMAGE: &str = "bench-memory1";
 /// A run takes well under a second; this only stops a hung image.
 const QEMU_TIMEOUT: Duration = Duration::from_secs(120);
-/// The aims: instructions per expedited SDO request and per RPDO.
+/// The aims: instructions per expedited SDO request and per RPDO.
 const AIMS: &[(&str, u64)] = &[("sdo-expedited", 800), ("rpdo", 400)];
 /// Criterion's defaults (3 s warm-up, 5 s measurement per benchmark) take about 4 minutes for
 /// the ~30 benchmarks here; these settings take under 2 and keep the means within a few %.

@@ -1,5 +1,5 @@
-//! How long a spec takes to load, validate and export. The `device!` proc-macro (next issue)
-//! pays the load + validate cost on every firmware build, so it is tracked here.
+//! How long a spec takes to load, validate and export. The `device!` proc-macro pays the
+//! load + validate cost on every firmware build, so it is tracked here.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;

@@ -1,5 +1,5 @@
 //! The four transcribed datasheets: they check clean, are canonically formatted, and hold
-//! the facts each issue depends on. Golden EDS/docs output of the fixture device.
+//! the facts the firmware depends on. Golden EDS/docs output of the fixture device.
 
 mod common;
 

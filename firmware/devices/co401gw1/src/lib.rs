@@ -1,5 +1,6 @@
-//! The co401gw1 device: its object dictionary tables and default PDOs, generated from
-//! `spec/co401gw1.yaml`. The device's behaviour comes with its own issue.
+//! The co401gw1 device, generated from `spec/co401gw1.yaml`: its dictionary, default PDOs, node
+//! settings, serial codecs and app hooks. It runs as a plain CANopen node until its behaviour
+//! is written.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(warnings)]

@@ -1,5 +1,6 @@
-//! The cr3101 device: its object dictionary tables and default PDOs, generated from
-//! `spec/cr3101.yaml`. The device's behaviour comes with its own issue.
+//! The cr3101 device, generated from `spec/cr3101.yaml`: its dictionary, default PDOs, node
+//! settings, serial codecs and app hooks. It runs as a plain CANopen node until its behaviour
+//! is written.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(warnings)]
