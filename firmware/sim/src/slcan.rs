@@ -1,14 +1,14 @@
-//! SLCAN for the simulator: the `no_std` codec of [`coforge_stack::slcan`] (which boards use
+//! SLCAN for the simulator: the `no_std` codec of [`coforge_slcan`] (which boards use
 //! too), with a decoder that queues the commands of many bytes and an encoder into a `Vec`.
 
+pub use coforge_slcan::{Command, MAX_LINE, bitrate, parse, reply};
 use coforge_stack::frame::CanFrame;
-pub use coforge_stack::slcan::{Command, MAX_LINE, bitrate, parse, reply};
 use std::collections::VecDeque;
 
-/// Appends the SLCAN line of `frame`, `\r` included (see [`coforge_stack::slcan::encode`]).
+/// Appends the SLCAN line of `frame`, `\r` included (see [`coforge_slcan::encode`]).
 pub fn encode(frame: &CanFrame, out: &mut Vec<u8>) {
-    let mut line = [0; coforge_stack::slcan::MAX_FRAME_LINE];
-    let n = coforge_stack::slcan::encode(frame, &mut line);
+    let mut line = [0; coforge_slcan::MAX_FRAME_LINE];
+    let n = coforge_slcan::encode(frame, &mut line);
     out.extend_from_slice(line.get(..n).unwrap_or_default());
 }
 
@@ -16,7 +16,7 @@ pub fn encode(frame: &CanFrame, out: &mut Vec<u8>) {
 /// completed lines through the [`Iterator`] implementation.
 #[derive(Debug, Clone, Default)]
 pub struct Decoder {
-    lines: coforge_stack::slcan::Decoder,
+    lines: coforge_slcan::Decoder,
     ready: VecDeque<Command>,
 }
 

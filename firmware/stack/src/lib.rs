@@ -7,8 +7,6 @@
 //! - [`config`]: how a device's node differs from plain CiA 301 (generated from the spec);
 //! - [`frame`]: the CAN frame exchanged with the board (an `embedded-can` frame);
 //! - [`sdo`]: the SDO server (expedited, segmented and block transfer);
-//! - [`slcan`]: the Lawicel ASCII codec, for boards that act as an SLCAN adapter of their own
-//!   node and for the simulator's hub;
 //! - the other protocol engines (NMT, PDO, EMCY, SYNC, heartbeat, guarding, store/restore)
 //!   and the [`node::Node`] that owns them.
 //!
@@ -31,6 +29,5 @@ pub mod node;
 pub mod od;
 pub mod pdo;
 pub mod sdo;
-pub mod slcan;
 pub mod store;
 pub mod value;

@@ -5,7 +5,7 @@
 use crate::clock;
 use crate::uart::{UART0, UART1, Uart};
 use co401memory1::{FixedBoard, Memory1};
-use coforge_stack::slcan::{self, Command};
+use coforge_slcan::{self as slcan, Command};
 use embedded_storage::Storage;
 
 /// Starts the module and serves both UARTs for ever.

@@ -21,8 +21,12 @@
 //! python-can reads the answers line by line, up to a `\r` or a BELL, and takes only lines that
 //! start with a frame letter (`t`, `T`, `r`, `R`, ...) as frames: a transmit acknowledge `z\r`,
 //! an OK `\r` and a BELL are skipped, so [`reply`] answers every line exactly as Lawicel does.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
+#![cfg_attr(test, allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
-use crate::frame::CanFrame;
+use coforge_stack::frame::CanFrame;
 
 /// Longest line the [`Decoder`] buffers; the longest valid one, an extended data frame with
 /// 8 bytes and a timestamp, has 30 characters. A longer line is discarded up to its end and
