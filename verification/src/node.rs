@@ -10,34 +10,12 @@
 use coforge_stack::frame::CanFrame;
 use coforge_stack::od::{Access, EntryInfo, NoAppObjects, SdoAbort, Side};
 use coforge_stack::store::BlockStore;
-use embedded_storage::{ReadStorage, Storage};
-
-/// An EEPROM image in RAM (erased to 0xFF).
-#[derive(Debug)]
-pub struct RamStorage<const N: usize>(pub [u8; N]);
-
-impl<const N: usize> ReadStorage for RamStorage<N> {
-    type Error = ();
-    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), ()> {
-        let start = usize::try_from(offset).map_err(|_| ())?;
-        bytes.copy_from_slice(self.0.get(start..start.checked_add(bytes.len()).ok_or(())?).ok_or(())?);
-        Ok(())
-    }
-    fn capacity(&self) -> usize {
-        N
-    }
-}
-
-impl<const N: usize> Storage for RamStorage<N> {
-    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), ()> {
-        let start = usize::try_from(offset).map_err(|_| ())?;
-        self.0.get_mut(start..start.checked_add(bytes.len()).ok_or(())?).ok_or(())?.copy_from_slice(bytes);
-        Ok(())
-    }
-}
+use coforge_storage::ram::RamEeprom;
 
 const NODE_ID: u8 = 5;
 const STORE: usize = 2048;
+/// The parameter store of the nodes under test: a block on an EEPROM image in RAM.
+pub type Store = BlockStore<RamEeprom<[u8; STORE]>>;
 /// Entries the stack writes itself although the bus may not.
 const STACK_MAINTAINED: [u16; 2] = [0x1001, 0x1003];
 /// Bytes of a read-only value kept for comparison.
@@ -82,8 +60,8 @@ fn valid_sdo_answer(data: &[u8; 8], block_upload: bool) -> bool {
 macro_rules! run_device {
     ($krate:ident, $input:expr) => {{
         let od = $krate::Od::new($krate::Mode::ALL[0], NODE_ID, NoAppObjects);
-        let store = BlockStore::new(RamStorage([0xFF; STORE]), 0);
-        let mut node: $krate::Node<NoAppObjects, BlockStore<RamStorage<STORE>>> = coforge_stack::node::Node::new(od, store, $krate::node_config(NODE_ID));
+        let store = BlockStore::new(RamEeprom::new(), 0);
+        let mut node: $krate::Node<NoAppObjects, Store> = coforge_stack::node::Node::new(od, store, $krate::node_config(NODE_ID));
         let entries = $krate::od::entries($krate::Mode::ALL[0]);
         drive(&mut node, entries, $input);
     }};
@@ -182,15 +160,15 @@ fn drive(node: &mut impl Driven, entries: &[EntryInfo], input: &[u8]) {
 /// Operational with TPDO1 and TPDO2 valid. Shared by the criterion bench and the callgrind
 /// example so both measure the same work.
 pub mod requests {
-    use super::{BlockStore, CanFrame, NODE_ID, NoAppObjects, RamStorage, STORE};
+    use super::{BlockStore, CanFrame, NODE_ID, NoAppObjects, RamEeprom, Store};
     use coforge_stack::od::Side;
 
-    pub type GwNode = co401gw1::Node<NoAppObjects, BlockStore<RamStorage<STORE>>>;
+    pub type GwNode = co401gw1::Node<NoAppObjects, Store>;
 
     /// A started node; TPDO1 and TPDO2 use `transmission_type`.
     pub fn node(transmission_type: u8) -> GwNode {
         let od = co401gw1::Od::new(co401gw1::Mode::Mixed, NODE_ID, NoAppObjects);
-        let mut node: GwNode = coforge_stack::node::Node::new(od, BlockStore::new(RamStorage([0xFF; STORE]), 0), co401gw1::node_config(NODE_ID));
+        let mut node: GwNode = coforge_stack::node::Node::new(od, BlockStore::new(RamEeprom::new(), 0), co401gw1::node_config(NODE_ID));
         node.start(0);
         for index in [0x1800_u16, 0x1801] {
             let _ = node.write(index, 2, &[transmission_type], Side::Device);

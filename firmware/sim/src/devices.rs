@@ -1,7 +1,7 @@
 //! The four coforge devices as simulator nodes, chosen by name at run time.
 
 use crate::app::RamApp;
-use crate::storage::MemStorage;
+use crate::storage::Eeprom;
 use coforge_stack::emcy::EmcyDefault;
 use coforge_stack::frame::CanFrame;
 use coforge_stack::node::{BusState, Node, NodeEvent};
@@ -111,14 +111,14 @@ pub struct DeviceKind {
 }
 
 /// An EEPROM of `capacity` bytes at `store`; `suffix` tells several apart in one file name.
-pub fn eeprom(store: &StoreAt, capacity: usize, suffix: &str) -> Result<MemStorage, String> {
+pub fn eeprom(store: &StoreAt, capacity: usize, suffix: &str) -> Result<Eeprom, String> {
     match store {
-        StoreAt::Memory => Ok(MemStorage::new(capacity)),
+        StoreAt::Memory => Ok(Eeprom::new(capacity)),
         StoreAt::File(path) => {
             let mut name = path.clone().into_os_string();
             name.push(suffix);
             let path = PathBuf::from(name);
-            MemStorage::with_file(capacity, &path).map_err(|e| format!("{}: {e}", path.display()))
+            Eeprom::with_file(capacity, &path).map_err(|e| format!("{}: {e}", path.display()))
         }
     }
 }
@@ -136,9 +136,9 @@ macro_rules! device_kind {
                     })?,
                 };
                 let size = <$krate::Od<RamApp> as NodeDictionary>::PERSISTENT_SIZE;
-                let storage = eeprom(store, BlockStore::<MemStorage>::capacity_for(size), "")?;
+                let storage = eeprom(store, BlockStore::<Eeprom>::capacity_for(size), "")?;
                 let od = $krate::Od::new(mode, node_id, RamApp::default());
-                let node: $krate::Node<RamApp, BlockStore<MemStorage>> = Node::new(od, BlockStore::new(storage, 0), $krate::node_config(node_id));
+                let node: $krate::Node<RamApp, BlockStore<Eeprom>> = Node::new(od, BlockStore::new(storage, 0), $krate::node_config(node_id));
                 Ok(Box::new(node))
             },
         }

@@ -2,7 +2,7 @@
 //! [`FixedBoard`] whose pins give the node-ID and whose supply voltage the console sets.
 
 use crate::devices::{SimNode, StoreAt, eeprom};
-use crate::storage::MemStorage;
+use crate::storage::Eeprom;
 use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
 use coforge_stack::device::{Device, HostPort};
 use coforge_stack::frame::CanFrame;
@@ -11,7 +11,7 @@ use coforge_stack::od::{ReadLen, SdoAbort, Side};
 use embedded_storage::{ReadStorage, Storage};
 
 /// The module on a board whose pins give `--node-id` and whose supply the console sets.
-pub type SimMemory1 = Memory1<MemStorage, FixedBoard>;
+pub type SimMemory1 = Memory1<Eeprom, FixedBoard>;
 
 /// Builds the module: banks in memory, or in `<store>.bank1` and `<store>.bank2`.
 pub fn build(mode: Option<&str>, node_id: u8, store: &StoreAt) -> Result<Box<dyn SimNode>, String> {

@@ -20,12 +20,12 @@
 use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
 use coforge_stack::frame::CanFrame;
 use coforge_stack::od::Side;
-use coforge_storage::ram::BorrowedEeprom;
+use coforge_storage::ram::RamEeprom;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
 
-type Device = Memory1<BorrowedEeprom<'static>, FixedBoard>;
+type Device = Memory1<RamEeprom<&'static mut [u8]>, FixedBoard>;
 
 const NODE_ID: u8 = 5;
 const SDO_RX: u16 = 0x600 + NODE_ID as u16;
@@ -192,7 +192,7 @@ fn stack_peak() -> usize {
 /// Builds the module into a `MaybeUninit` static, in a frame of its own: the construction's
 /// temporaries are gone when it returns, instead of staying in `main`'s frame for ever.
 #[inline(never)]
-fn mount(banks: [BorrowedEeprom<'static>; 2]) -> &'static mut Device {
+fn mount(banks: [RamEeprom<&'static mut [u8]>; 2]) -> &'static mut Device {
     let Ok(device) = Memory1::new(banks, FixedBoard::new(NODE_ID)) else { panic!("reserved configuration pins") };
     let Some(device) = cortex_m::singleton!(: Device = device) else { panic!("mounted twice") };
     device
@@ -203,7 +203,7 @@ fn main() -> ! {
     static mut BANK1: [u8; BANK_SIZE] = [0; BANK_SIZE];
     static mut BANK2: [u8; BANK_SIZE] = [0; BANK_SIZE];
     paint_stack();
-    let device = mount([BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)]);
+    let device = mount([RamEeprom::erased(BANK1), RamEeprom::erased(BANK2)]);
 
     // Unmeasured setup. Boot-up, then the EMCYs of the freshly cleared banks (status 0x40).
     device.start(0);

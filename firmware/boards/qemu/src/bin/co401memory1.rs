@@ -10,7 +10,7 @@
 #![no_main]
 
 use co401memory1::BANK_SIZE;
-use coforge_storage::ram::BorrowedEeprom;
+use coforge_storage::ram::RamEeprom;
 use cortex_m_rt::entry;
 use panic_semihosting as _;
 
@@ -20,5 +20,5 @@ fn main() -> ! {
     // module only borrows them, so nothing large is built on the stack.
     static mut BANK1: [u8; BANK_SIZE] = [0; BANK_SIZE];
     static mut BANK2: [u8; BANK_SIZE] = [0; BANK_SIZE];
-    coforge_board_qemu::serve_memory1!(BorrowedEeprom<'static>, [BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)])
+    coforge_board_qemu::serve_memory1!(RamEeprom<&'static mut [u8]>, [RamEeprom::erased(BANK1), RamEeprom::erased(BANK2)])
 }
