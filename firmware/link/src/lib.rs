@@ -154,6 +154,28 @@ pub trait Deframer {
     fn reset(&mut self);
 }
 
+/// One direction's commands of a generated serial protocol (`serial::HostToDevice`,
+/// `serial::DeviceToHost`), borrowing the frame's data for `'a`.
+pub trait Message<'a>: Sized + Copy + PartialEq + core::fmt::Debug {
+    /// The command a decoded frame carries.
+    fn decode(frame: &Frame<'a>) -> Result<Self, fields::DecodeError>;
+    /// Writes the whole frame into `out`; returns its length.
+    fn encode(&self, out: &mut [u8]) -> Result<usize, EncodeError>;
+    /// The command's name in the spec.
+    fn name(&self) -> &'static str;
+}
+
+/// A device's generated serial protocol as one type (`serial::Codec`), so that code can be
+/// generic over devices: its decoder and the commands of both directions.
+pub trait SerialCodec {
+    type Decoder: Deframer;
+    type HostToDevice<'a>: Message<'a>;
+    type DeviceToHost<'a>: Message<'a>;
+
+    /// A fresh decoder.
+    fn decoder() -> Self::Decoder;
+}
+
 /// Writes `bytes` to the front of `out`, or says how much room was needed.
 fn put(out: &mut [u8], bytes: &[u8]) -> Result<usize, EncodeError> {
     let dst = out.get_mut(..bytes.len()).ok_or(EncodeError::BufferTooSmall { needed: bytes.len() })?;
