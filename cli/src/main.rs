@@ -171,9 +171,9 @@ fn sim(args: SimArgs<'_>) -> Result<ExitCode, String> {
         return Err("--store keeps one node's parameters; use it with --nodes 1".into());
     }
     let at = store.map_or(StoreAt::Memory, StoreAt::File);
-    let nodes = (first_id..first_id + count).map(|id| kind.create(mode, id, &at)).collect::<Result<Vec<_>, _>>()?;
+    let mut nodes = (first_id..first_id + count).map(|id| kind.create(mode, id, &at)).collect::<Result<Vec<_>, _>>()?;
     let hub = coforge_sim::hub::Hub::bind(("127.0.0.1", port)).map_err(|e| format!("cannot listen on port {port}: {e}"))?;
-    let has_serial = nodes.first().is_some_and(|n| n.has_serial());
+    let has_serial = nodes.first_mut().is_some_and(|n| n.host_port().is_some());
     let running = coforge_sim::runner::spawn(&hub, nodes);
     if let Some(serial_port) = serial {
         if !has_serial {

@@ -15,11 +15,13 @@ const COUNTER_MASK: u32 = 0x00FF_FFFF;
 const CLOCKS_PER_MS: u32 = CORE_HZ / 1000;
 
 // Only the main loop reads the clock (no interrupt does), so plain loads and stores suffice;
-// atomics only because statics must be `Sync` (thumbv6m has no read-modify-write).
+// atomics only because statics must be `Sync` (thumbv6m has no read-modify-write, neither
+// Cortex-M has 64-bit atomics: the milliseconds are two words).
 // 0 reads as the top of the first count: the first call sees the few clocks since `start`.
 static LAST_COUNT: AtomicU32 = AtomicU32::new(0);
 static CLOCKS: AtomicU32 = AtomicU32::new(0);
-static MILLIS: AtomicU32 = AtomicU32::new(0);
+static MILLIS_LOW: AtomicU32 = AtomicU32::new(0);
+static MILLIS_HIGH: AtomicU32 = AtomicU32::new(0);
 
 /// Starts the clock: SysTick counts the core clock down over its whole range, without
 /// interrupts.
@@ -30,15 +32,18 @@ pub fn start(mut syst: SYST) {
     syst.enable_counter();
 }
 
-/// Milliseconds since [`start`] (wraps after 49 days; only differences are used).
-pub fn millis() -> u32 {
+/// Milliseconds since [`start`], 64 bits wide: no wrap after 49 days.
+pub fn millis() -> u64 {
     let now = SYST::get_current();
     // The counter counts down: what it ran since the last call, across one reload.
     let ran = LAST_COUNT.load(Ordering::Relaxed).wrapping_sub(now) & COUNTER_MASK;
     LAST_COUNT.store(now, Ordering::Relaxed);
     let clocks = CLOCKS.load(Ordering::Relaxed) + ran;
     CLOCKS.store(clocks % CLOCKS_PER_MS, Ordering::Relaxed);
-    let ms = MILLIS.load(Ordering::Relaxed).wrapping_add(clocks / CLOCKS_PER_MS);
-    MILLIS.store(ms, Ordering::Relaxed);
-    ms
+    // The low word's carry goes to the high word.
+    let (low, wrapped) = MILLIS_LOW.load(Ordering::Relaxed).overflowing_add(clocks / CLOCKS_PER_MS);
+    MILLIS_LOW.store(low, Ordering::Relaxed);
+    let high = MILLIS_HIGH.load(Ordering::Relaxed).wrapping_add(u32::from(wrapped));
+    MILLIS_HIGH.store(high, Ordering::Relaxed);
+    u64::from(high) << 32 | u64::from(low)
 }

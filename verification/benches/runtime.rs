@@ -2,7 +2,7 @@
 //! dispatch, and deframing + decoding of each device's datasheet frames (per frame and per
 //! byte). Cortex-M instruction counts come with the board images.
 
-use coforge_link::{Deframer, Frame};
+use coforge_link::{Deframer, Message, SerialCodec};
 use coforge_stack::od::{AccessContext, EntryAccess, NmtState, NoAppObjects, Side};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -18,19 +18,16 @@ fn dictionary(c: &mut Criterion) {
     c.bench_function("od/co401gw1/refused_write_1000", |b| b.iter(|| od.write(black_box(0x1000), 0, black_box(&[0; 4]), Side::Bus, &OP)));
 }
 
-/// Deframes and decodes one frame; returns whether it decoded.
-macro_rules! decode_once {
-    ($device:ident, $bytes:expr) => {{
-        let mut d = $device::serial::decoder();
-        let mut ok = false;
-        for (i, &b) in $bytes.iter().enumerate() {
-            if let Some(Ok(f)) = d.push(b, i as u32) {
-                let f: Frame<'_> = f;
-                ok = $device::serial::HostToDevice::decode(&f).is_ok() || $device::serial::DeviceToHost::decode(&f).is_ok();
-            }
+/// Deframes and decodes one frame with codec `C`; returns whether it decoded.
+fn decode_once<C: SerialCodec>(bytes: &[u8]) -> bool {
+    let mut d = C::decoder();
+    let mut ok = false;
+    for (i, &b) in bytes.iter().enumerate() {
+        if let Some(Ok(f)) = d.push(b, i as u32) {
+            ok = C::HostToDevice::decode(&f).is_ok() || C::DeviceToHost::decode(&f).is_ok();
         }
-        ok
-    }};
+    }
+    ok
 }
 
 fn codecs(c: &mut Criterion) {
@@ -44,9 +41,9 @@ fn codecs(c: &mut Criterion) {
         group.throughput(Throughput::Bytes(bytes.len() as u64));
         group.bench_function(name, |b| {
             b.iter(|| match name.split('/').next() {
-                Some("co401memory1") => decode_once!(co401memory1, black_box(bytes)),
-                Some("co401gw1") => decode_once!(co401gw1, black_box(bytes)),
-                _ => decode_once!(canopenia, black_box(bytes)),
+                Some("co401memory1") => decode_once::<co401memory1::serial::Codec>(black_box(bytes)),
+                Some("co401gw1") => decode_once::<co401gw1::serial::Codec>(black_box(bytes)),
+                _ => decode_once::<canopenia::serial::Codec>(black_box(bytes)),
             })
         });
     }

@@ -7,37 +7,17 @@
 //!   1001h error register, 1003h error history);
 //! - every SDO answer is a valid server response or an abort with a CiA 301 code.
 
+use coforge_stack::device::{Assemble, NodeAccess};
 use coforge_stack::frame::CanFrame;
-use coforge_stack::od::{Access, EntryInfo, NoAppObjects, SdoAbort, Side};
-use coforge_stack::store::BlockStore;
-use embedded_storage::{ReadStorage, Storage};
-
-/// An EEPROM image in RAM (erased to 0xFF).
-#[derive(Debug)]
-pub struct RamStorage<const N: usize>(pub [u8; N]);
-
-impl<const N: usize> ReadStorage for RamStorage<N> {
-    type Error = ();
-    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), ()> {
-        let start = usize::try_from(offset).map_err(|_| ())?;
-        bytes.copy_from_slice(self.0.get(start..start.checked_add(bytes.len()).ok_or(())?).ok_or(())?);
-        Ok(())
-    }
-    fn capacity(&self) -> usize {
-        N
-    }
-}
-
-impl<const N: usize> Storage for RamStorage<N> {
-    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), ()> {
-        let start = usize::try_from(offset).map_err(|_| ())?;
-        self.0.get_mut(start..start.checked_add(bytes.len()).ok_or(())?).ok_or(())?.copy_from_slice(bytes);
-        Ok(())
-    }
-}
+use coforge_stack::node::Node;
+use coforge_stack::od::{Access, EntryInfo, NoAppObjects, NodeDictionary, SdoAbort, Side};
+use coforge_stack::store::{BlockStore, ParamStore};
+use coforge_storage::ram::RamEeprom;
 
 const NODE_ID: u8 = 5;
 const STORE: usize = 2048;
+/// The parameter store of the nodes under test: a block on an EEPROM image in RAM.
+pub type Store = BlockStore<RamEeprom<[u8; STORE]>>;
 /// Entries the stack writes itself although the bus may not.
 const STACK_MAINTAINED: [u16; 2] = [0x1001, 0x1003];
 /// Bytes of a read-only value kept for comparison.
@@ -79,59 +59,30 @@ fn valid_sdo_answer(data: &[u8; 8], block_upload: bool) -> bool {
     }
 }
 
-macro_rules! run_device {
-    ($krate:ident, $input:expr) => {{
-        let od = $krate::Od::new($krate::Mode::ALL[0], NODE_ID, NoAppObjects);
-        let store = BlockStore::new(RamStorage([0xFF; STORE]), 0);
-        let mut node: $krate::Node<NoAppObjects, BlockStore<RamStorage<STORE>>> = coforge_stack::node::Node::new(od, store, $krate::node_config(NODE_ID));
-        let entries = $krate::od::entries($krate::Mode::ALL[0]);
-        drive(&mut node, entries, $input);
-    }};
-}
-
 /// Checks the invariants for one input; the first byte picks the device.
 pub fn prop_node_frames(input: &[u8]) {
     let Some((&pick, rest)) = input.split_first() else { return };
     match pick % 3 {
-        0 => run_device!(co401gw1, rest),
-        1 => run_device!(cr3101, rest),
-        _ => run_device!(canopenia, rest),
+        0 => drive(assembled::<co401gw1::Node<NoAppObjects, Store>>(), rest),
+        1 => drive(assembled::<cr3101::Node<NoAppObjects, Store>>(), rest),
+        _ => drive(assembled::<canopenia::Node<NoAppObjects, Store>>(), rest),
     }
 }
 
-trait Driven {
-    fn start(&mut self, now: u64);
-    fn on_frame(&mut self, f: &CanFrame, now: u64);
-    fn poll(&mut self, now: u64) -> Option<CanFrame>;
-    fn read_device(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Option<usize>;
-}
-
-impl<D: coforge_stack::od::NodeDictionary, S: coforge_stack::store::ParamStore, const N: usize, const P: usize> Driven
-    for coforge_stack::node::Node<D, S, N, P>
-{
-    fn start(&mut self, now: u64) {
-        coforge_stack::node::Node::start(self, now);
-    }
-    fn on_frame(&mut self, f: &CanFrame, now: u64) {
-        coforge_stack::node::Node::on_frame(self, f, now);
-    }
-    fn poll(&mut self, now: u64) -> Option<CanFrame> {
-        coforge_stack::node::Node::poll(self, now)
-    }
-    fn read_device(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Option<usize> {
-        self.read(index, sub, 0, buf, Side::Device).ok().map(|r| r.copied)
-    }
+/// A device in its default mode at [`NODE_ID`] on an erased EEPROM, as a runtime builds it.
+fn assembled<T: Assemble<RamEeprom<[u8; STORE]>>>() -> T {
+    T::assemble(None, NODE_ID, &mut |_| Some(RamEeprom::new())).unwrap_or_else(|e| panic!("cannot assemble: {e:?}"))
 }
 
 type Snapshot = ([(u16, u8, usize, [u8; VALUE]); MAX_WATCHED], usize);
 
-fn snapshot(node: &mut impl Driven, entries: &[EntryInfo]) -> Snapshot {
+fn snapshot(node: &mut dyn NodeAccess, entries: &[EntryInfo]) -> Snapshot {
     let mut out = ([(0, 0, 0, [0; VALUE]); MAX_WATCHED], 0);
     let watched = entries.iter().filter(|e| matches!(e.access, Access::Ro | Access::Const) && !STACK_MAINTAINED.contains(&e.index));
     for e in watched {
         for sub in e.sub..=e.last_sub {
             let mut buf = [0; VALUE];
-            if let Some(n) = node.read_device(e.index, sub, &mut buf)
+            if let Ok(n) = node.read(e.index, sub, 0, &mut buf, Side::Device).map(|r| r.copied)
                 && let Some(slot) = out.0.get_mut(out.1)
             {
                 *slot = (e.index, sub, n, buf);
@@ -142,9 +93,10 @@ fn snapshot(node: &mut impl Driven, entries: &[EntryInfo]) -> Snapshot {
     out
 }
 
-fn drive(node: &mut impl Driven, entries: &[EntryInfo], input: &[u8]) {
+fn drive<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize>(mut node: Node<D, S, N, P>, input: &[u8]) {
+    let entries = node.od().entries();
     node.start(0);
-    let before = snapshot(node, entries);
+    let before = snapshot(&mut node, entries);
     let mut now = 0_u64;
     let mut block_upload = false;
     for chunk in input.chunks(12) {
@@ -171,7 +123,7 @@ fn drive(node: &mut impl Driven, entries: &[EntryInfo], input: &[u8]) {
             }
         }
     }
-    let after = snapshot(node, entries);
+    let after = snapshot(&mut node, entries);
     assert_eq!(before.1, after.1, "read-only entries appeared or vanished");
     for (b, a) in before.0.iter().zip(after.0.iter()).take(before.1) {
         assert_eq!(b, a, "read-only entry {:04X}h.{} changed", b.0, b.1);
@@ -182,15 +134,14 @@ fn drive(node: &mut impl Driven, entries: &[EntryInfo], input: &[u8]) {
 /// Operational with TPDO1 and TPDO2 valid. Shared by the criterion bench and the callgrind
 /// example so both measure the same work.
 pub mod requests {
-    use super::{BlockStore, CanFrame, NODE_ID, NoAppObjects, RamStorage, STORE};
+    use super::{BlockStore, CanFrame, NODE_ID, NoAppObjects, RamEeprom, Store};
     use coforge_stack::od::Side;
 
-    pub type GwNode = co401gw1::Node<NoAppObjects, BlockStore<RamStorage<STORE>>>;
+    pub type GwNode = co401gw1::Node<NoAppObjects, Store>;
 
     /// A started node; TPDO1 and TPDO2 use `transmission_type`.
     pub fn node(transmission_type: u8) -> GwNode {
-        let od = co401gw1::Od::new(co401gw1::Mode::Mixed, NODE_ID, NoAppObjects);
-        let mut node: GwNode = coforge_stack::node::Node::new(od, BlockStore::new(RamStorage([0xFF; STORE]), 0), co401gw1::node_config(NODE_ID));
+        let mut node = GwNode::of_dictionary(co401gw1::Mode::Mixed, NODE_ID, NoAppObjects, BlockStore::new(RamEeprom::new(), 0));
         node.start(0);
         for index in [0x1800_u16, 0x1801] {
             let _ = node.write(index, 2, &[transmission_type], Side::Device);

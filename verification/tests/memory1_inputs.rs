@@ -13,7 +13,7 @@ use proptest::prelude::*;
 
 const NODE: u16 = 5;
 
-type Dev = Memory1<RamEeprom<BANK_SIZE>, FixedBoard>;
+type Dev = Memory1<RamEeprom<[u8; BANK_SIZE]>, FixedBoard>;
 
 /// A module whose memory holds a known pattern, started and operational.
 fn device() -> Dev {
@@ -54,7 +54,7 @@ fn writes_memory(input: &Input) -> bool {
 
 fn images(dev: &Dev) -> Vec<u8> {
     let banks = dev.node().od().app.banks().banks();
-    [banks[0].as_bytes().as_slice(), banks[1].as_bytes().as_slice()].concat()
+    [banks[0].as_bytes(), banks[1].as_bytes()].concat()
 }
 
 proptest! {

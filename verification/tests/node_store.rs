@@ -4,7 +4,7 @@
 use co401gw1::{Mode, Od};
 use coforge_stack::od::{AccessContext, Area, EntryAccess, NmtState, NoAppObjects, Side};
 use coforge_stack::store::{BlockStore, ParamStore};
-use coforge_verification::node::RamStorage;
+use coforge_storage::ram::RamEeprom;
 
 const PREOP: AccessContext = AccessContext { nmt: NmtState::PreOperational, can_enabled: true };
 
@@ -14,10 +14,10 @@ fn guard_time(od: &mut Od<NoAppObjects>) -> u16 {
     u16::from_le_bytes(buf)
 }
 
-fn saved_block() -> BlockStore<RamStorage<2048>> {
+fn saved_block() -> BlockStore<RamEeprom<[u8; 2048]>> {
     let mut od = Od::new(Mode::Mixed, 5, NoAppObjects);
     od.write(0x100C, 0, &500_u16.to_le_bytes(), Side::Bus, &PREOP).expect("writable in pre-operational");
-    let mut store = BlockStore::new(RamStorage([0xFF; 2048]), 0);
+    let mut store = BlockStore::new(RamEeprom::new(), 0);
     store.save(&od, Area::ALL).expect("fits");
     store
 }
@@ -36,7 +36,7 @@ fn every_corrupted_byte_falls_back_to_defaults() {
     for at in 0..len {
         let mut image = saved_block().into_inner();
         // Every byte of header (magic, length, CRC, reserved) and data.
-        image.0[at] ^= 0x5A;
+        image.as_bytes_mut()[at] ^= 0x5A;
         let mut store = BlockStore::new(image, 0);
         let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
         assert_eq!(store.load(&mut fresh, Area::ALL), Ok(false), "corrupted byte {at} was accepted");
@@ -51,21 +51,21 @@ fn erase_and_a_too_small_device_are_handled() {
     let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
     assert_eq!(store.load(&mut fresh, Area::ALL), Ok(false), "1011h: nothing valid stored");
     let od = Od::new(Mode::Mixed, 5, NoAppObjects);
-    let mut tiny = BlockStore::new(RamStorage([0xFF; 16]), 0);
+    let mut tiny = BlockStore::new(RamEeprom::<[u8; 16]>::new(), 0);
     assert!(tiny.save(&od, Area::ALL).is_err(), "a block larger than the device is refused");
 }
 
 /// A storage device that fails every write after `budget` of them: a save torn at any point.
 #[derive(Debug)]
 struct Torn {
-    image: RamStorage<2048>,
+    image: RamEeprom<[u8; 2048]>,
     budget: usize,
 }
 
 impl embedded_storage::ReadStorage for Torn {
     type Error = ();
     fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), ()> {
-        self.image.read(offset, bytes)
+        self.image.read(offset, bytes).map_err(|_| ())
     }
     fn capacity(&self) -> usize {
         self.image.capacity()
@@ -78,7 +78,7 @@ impl embedded_storage::Storage for Torn {
             return Err(());
         }
         self.budget -= 1;
-        self.image.write(offset, bytes)
+        self.image.write(offset, bytes).map_err(|_| ())
     }
 }
 
@@ -93,7 +93,7 @@ fn a_save_torn_at_any_write_keeps_the_previous_block() {
     let image = saved_block().into_inner();
     let mut completed = false;
     for budget in 0..2000 {
-        let mut store = BlockStore::new(Torn { image: RamStorage(image.0), budget }, 0);
+        let mut store = BlockStore::new(Torn { image: image.clone(), budget }, 0);
         let result = store.save(&od_with_guard_time(700), Area::ALL);
         let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
         assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true), "a block is always there (budget {budget})");
@@ -117,7 +117,7 @@ fn the_newest_block_wins_and_a_corrupt_newest_falls_back_to_the_previous() {
     assert_eq!(guard_time(&mut fresh), 900, "three saves: the last one wins");
     // The third save went to slot 0 again; corrupt its data.
     let mut image = store.into_inner();
-    image.0[12] ^= 0xFF;
+    image.as_bytes_mut()[12] ^= 0xFF;
     let mut store = BlockStore::new(image, 0);
     let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
     assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true));

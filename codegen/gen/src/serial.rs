@@ -1,5 +1,6 @@
-//! `serial`: the framing's configuration and decoder, and per direction an enum of the
-//! protocol's commands with typed fields, `decode(&Frame)` and `encode(&mut [u8])`.
+//! `serial`: the framing's configuration and decoder, per direction an enum of the
+//! protocol's commands with typed fields, `decode(&Frame)` and `encode(&mut [u8])`, and
+//! `Codec`, the whole protocol as one `coforge_link::SerialCodec` for generic code.
 
 use crate::Options;
 use crate::naming::{camel, ident as field_ident};
@@ -122,9 +123,33 @@ fn field_codec(ty: FieldType, at: u32, big_endian: bool, name: &Ident) -> (Token
     }
 }
 
-fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
+/// The lifetime of a direction's enum: `<'a>` if a command's tail borrows the frame.
+fn lifetime(cmds: &[&Command]) -> TokenStream {
     let borrows = cmds.iter().any(|c| c.fields.iter().any(|f| matches!(f.ty, FieldType::Tail { .. })));
-    let lt = if borrows { quote!(<'a>) } else { quote!() };
+    if borrows { quote!(<'a>) } else { quote!() }
+}
+
+fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
+    if cmds.is_empty() {
+        // No command goes this way: an enum without values keeps `Codec` complete.
+        return quote! {
+            #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+            pub enum #enum_name {}
+
+            impl<'a> ::coforge_link::Message<'a> for #enum_name {
+                fn decode(frame: &::coforge_link::Frame<'a>) -> Result<Self, ::coforge_link::fields::DecodeError> {
+                    Err(::coforge_link::fields::DecodeError::UnknownCommand { code: frame.code })
+                }
+                fn encode(&self, _: &mut [u8]) -> Result<usize, ::coforge_link::EncodeError> {
+                    match *self {}
+                }
+                fn name(&self) -> &'static str {
+                    match *self {}
+                }
+            }
+        };
+    }
+    let lt = lifetime(cmds);
     let mut variants = Vec::new();
     let mut decode_arms = Vec::new();
     let mut encode_arms = Vec::new();
@@ -253,6 +278,18 @@ fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
                 match self { #(#name_arms),* }
             }
         }
+
+        impl<'a> ::coforge_link::Message<'a> for #enum_name #lt {
+            fn decode(frame: &::coforge_link::Frame<'a>) -> Result<Self, ::coforge_link::fields::DecodeError> {
+                Self::decode(frame)
+            }
+            fn encode(&self, out: &mut [u8]) -> Result<usize, ::coforge_link::EncodeError> {
+                Self::encode(self, out)
+            }
+            fn name(&self) -> &'static str {
+                Self::name(self)
+            }
+        }
     }
 }
 
@@ -260,16 +297,11 @@ pub fn serial_module(d: &Device, _options: &Options) -> TokenStream {
     let Some(serial) = &d.serial else { return quote!() };
     let max_data = serial.commands.iter().map(|c| c.length.1 as usize).max().unwrap_or(0).max(1);
     let (framing, put, new_decoder) = framing_tokens(&serial.framing, max_data);
-    let dirs: Vec<TokenStream> = [(Direction::HostToDevice, "HostToDevice"), (Direction::DeviceToHost, "DeviceToHost")]
-        .into_iter()
-        .map(|(dir, name)| {
-            let cmds: Vec<&Command> = serial.commands.iter().filter(|c| c.direction == dir).collect();
-            if cmds.is_empty() {
-                return quote!();
-            }
-            direction_enum(&cmds, &Ident::new(name, Span::call_site()))
-        })
-        .collect();
+    let commands = |dir| serial.commands.iter().filter(|c| c.direction == dir).collect::<Vec<&Command>>();
+    let (to_device, to_host) = (commands(Direction::HostToDevice), commands(Direction::DeviceToHost));
+    let dirs =
+        [direction_enum(&to_device, &Ident::new("HostToDevice", Span::call_site())), direction_enum(&to_host, &Ident::new("DeviceToHost", Span::call_site()))];
+    let (to_device_lt, to_host_lt) = (lifetime(&to_device), lifetime(&to_host));
     let max = crate::dec(max_data as u64);
     quote! {
         /// The serial protocol: framing, decoder and typed commands, generated from the spec.
@@ -290,6 +322,20 @@ pub fn serial_module(d: &Device, _options: &Options) -> TokenStream {
             }
 
             #(#dirs)*
+
+            /// The protocol as one type, for code generic over devices.
+            #[derive(Debug, Clone, Copy, Default)]
+            pub struct Codec;
+
+            impl ::coforge_link::SerialCodec for Codec {
+                type Decoder = Decoder;
+                type HostToDevice<'a> = HostToDevice #to_device_lt;
+                type DeviceToHost<'a> = DeviceToHost #to_host_lt;
+
+                fn decoder() -> Decoder {
+                    decoder()
+                }
+            }
         }
     }
 }

@@ -42,13 +42,15 @@ pub struct MillisClock {
 impl MillisClock {
     /// The clock at `now_us` (times never run backwards; an earlier time reads as no time).
     pub fn at(&mut self, now_us: u64) -> Millis {
-        let step = now_us.saturating_sub(self.last_us);
-        self.last_us = self.last_us.max(now_us);
-        // A step beyond 71 minutes only needs to read as long: the framings compare pauses
-        // of milliseconds.
-        let step = u32::try_from(step).unwrap_or(u32::MAX / 2).saturating_add(self.carry_us);
-        self.ms = self.ms.wrapping_add(step / 1000);
-        self.carry_us = step % 1000;
+        // Nothing to do for bytes that arrive in the same pass of a main loop.
+        if now_us > self.last_us {
+            // A step beyond 35 minutes only needs to read as long: the framings compare
+            // pauses of milliseconds.
+            let step = (now_us - self.last_us).min(u64::from(u32::MAX / 2)) as u32 + self.carry_us;
+            self.last_us = now_us;
+            self.ms = self.ms.wrapping_add(step / 1000);
+            self.carry_us = step % 1000;
+        }
         self.ms
     }
 }
@@ -93,9 +95,11 @@ impl<const N: usize> Outbox<N> {
     /// Moves waiting bytes into `out`; returns how many.
     pub fn take(&mut self, out: &mut [u8]) -> usize {
         let waiting = self.bytes.get(self.start..self.end).unwrap_or(&[]);
-        let n = waiting.len().min(out.len());
-        if let (Some(dst), Some(src)) = (out.get_mut(..n), waiting.get(..n)) {
-            dst.copy_from_slice(src);
+        // Byte by byte: answers are a few bytes, shorter than a `memcpy` call's set-up.
+        let mut n = 0;
+        for (dst, &src) in out.iter_mut().zip(waiting) {
+            *dst = src;
+            n += 1;
         }
         self.start += n;
         n
@@ -154,6 +158,28 @@ pub trait Deframer {
     fn reset(&mut self);
 }
 
+/// One direction's commands of a generated serial protocol (`serial::HostToDevice`,
+/// `serial::DeviceToHost`), borrowing the frame's data for `'a`.
+pub trait Message<'a>: Sized + Copy + PartialEq + core::fmt::Debug {
+    /// The command a decoded frame carries.
+    fn decode(frame: &Frame<'a>) -> Result<Self, fields::DecodeError>;
+    /// Writes the whole frame into `out`; returns its length.
+    fn encode(&self, out: &mut [u8]) -> Result<usize, EncodeError>;
+    /// The command's name in the spec.
+    fn name(&self) -> &'static str;
+}
+
+/// A device's generated serial protocol as one type (`serial::Codec`), so that code can be
+/// generic over devices: its decoder and the commands of both directions.
+pub trait SerialCodec {
+    type Decoder: Deframer;
+    type HostToDevice<'a>: Message<'a>;
+    type DeviceToHost<'a>: Message<'a>;
+
+    /// A fresh decoder.
+    fn decoder() -> Self::Decoder;
+}
+
 /// Writes `bytes` to the front of `out`, or says how much room was needed.
 fn put(out: &mut [u8], bytes: &[u8]) -> Result<usize, EncodeError> {
     let dst = out.get_mut(..bytes.len()).ok_or(EncodeError::BufferTooSmall { needed: bytes.len() })?;
@@ -186,7 +212,7 @@ mod clock_tests {
         }
         assert_eq!(c.at(now), 3 + 17_000);
         assert_eq!(c.at(now - 5_000), 3 + 17_000, "an earlier time reads as no time");
-        assert!(elapsed(17_003, c.at(now + 5_000_000_000)) >= 1_000_000, "a 83-minute gap reads as long");
+        assert!(elapsed(17_003, c.at(now + 5_000_000_000)) >= 1_000_000, "an 83-minute gap reads as long");
     }
 
     #[test]

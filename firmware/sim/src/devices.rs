@@ -1,107 +1,85 @@
-//! The four coforge devices as simulator nodes, chosen by name at run time.
+//! The coforge devices the simulator runs, by name: one registry line per device, each built
+//! through the device contract ([`Assemble`]) and driven through it ([`Device`]).
 
 use crate::app::RamApp;
-use crate::storage::MemStorage;
+use crate::storage::Eeprom;
+use co401memory1::{FixedBoard, Memory1};
+use coforge_stack::device::{Assemble, AssembleError, Device, MemoryRequest, NodeAccess};
 use coforge_stack::emcy::EmcyDefault;
-use coforge_stack::frame::CanFrame;
-use coforge_stack::node::{BusState, Node, NodeEvent};
-use coforge_stack::od::{NodeDictionary, ReadLen, SdoAbort, Side};
+use coforge_stack::node::Node;
+use coforge_stack::od::NodeDictionary;
 use coforge_stack::store::{BlockStore, ParamStore};
 use std::path::PathBuf;
 
-/// A running device, whatever its dictionary type.
-pub trait SimNode: Send {
-    fn start(&mut self, now_us: u64);
-    fn on_frame(&mut self, frame: &CanFrame, now_us: u64);
-    fn poll(&mut self, now_us: u64) -> Option<CanFrame>;
-    fn state(&self) -> coforge_stack::nmt::NmtState;
-    fn node_id(&self) -> u8;
-    /// A read or write as the device itself (no access rules; lengths and limits apply).
-    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
-    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort>;
-    /// The spec emergency called `name` (fault injection); `false` if there is none.
-    fn raise(&mut self, name: &str) -> bool;
-    fn clear(&mut self, name: &str) -> bool;
-    fn on_bus_state(&mut self, bus: BusState, now_us: u64);
-    fn take_event(&mut self) -> Option<NodeEvent>;
-    fn trigger_tpdo(&mut self, number: u16);
-    /// CiA 303-3 indicator states.
-    fn leds(&self) -> coforge_stack::leds::Leds;
-    /// Whether the device has a serial host interface.
-    fn has_serial(&self) -> bool {
-        false
-    }
-    /// One byte from the serial host, received at `now_ms`; the answer, if this byte
-    /// completes a command, goes to `out` and its length is returned.
-    fn serial_byte(&mut self, _byte: u8, _now_ms: u32, _out: &mut [u8]) -> usize {
-        0
-    }
-    /// A fault-injection command from the simulator's console (see `coforge sim --help`).
-    fn control(&mut self, command: &str) -> Result<String, String> {
+/// Every device, by crate name.
+pub const DEVICES: &[DeviceKind] = &[
+    DeviceKind::of::<Memory1<Eeprom, FixedBoard>>("co401memory1"),
+    DeviceKind::of::<co401gw1::Node<RamApp, BlockStore<Eeprom>>>("co401gw1"),
+    DeviceKind::of::<cr3101::Node<RamApp, BlockStore<Eeprom>>>("cr3101"),
+    DeviceKind::of::<canopenia::Node<RamApp, BlockStore<Eeprom>>>("canopenia"),
+];
+
+/// Fault-injection commands typed on the simulator's console (see `coforge sim --help`).
+pub trait Console {
+    /// Runs `command`; what it did, or why not.
+    fn console(&mut self, command: &str) -> Result<String, String> {
         Err(format!("this device takes no console commands (got `{command}`)"))
     }
 }
 
-impl<D, S, const N: usize, const P: usize> SimNode for Node<D, S, N, P>
-where
-    D: NodeDictionary + Send,
-    S: ParamStore + Send,
-{
-    fn start(&mut self, now_us: u64) {
-        Node::start(self, now_us);
-    }
-    fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
-        Node::on_frame(self, frame, now_us);
-    }
-    fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
-        Node::poll(self, now_us)
-    }
-    fn state(&self) -> coforge_stack::nmt::NmtState {
-        Node::state(self)
-    }
-    fn node_id(&self) -> u8 {
-        Node::node_id(self)
-    }
-    fn read(&mut self, index: u16, sub: u8, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
-        Node::read(self, index, sub, 0, buf, Side::Device)
-    }
-    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
-        Node::write(self, index, sub, data, side)
-    }
-    fn raise(&mut self, name: &str) -> bool {
-        let found: Option<EmcyDefault> = self.od().emergencies().iter().find(|e| e.name == name).copied();
-        found.map(|e| Node::raise(self, &e)).is_some()
-    }
-    fn clear(&mut self, name: &str) -> bool {
-        let found: Option<EmcyDefault> = self.od().emergencies().iter().find(|e| e.name == name).copied();
-        found.map(|e| Node::clear(self, &e)).is_some()
-    }
-    fn on_bus_state(&mut self, bus: BusState, now_us: u64) {
-        Node::on_bus_state(self, bus, now_us);
-    }
-    fn take_event(&mut self) -> Option<NodeEvent> {
-        Node::take_event(self)
-    }
-    fn trigger_tpdo(&mut self, number: u16) {
-        Node::trigger_tpdo(self, number);
-    }
-    fn leds(&self) -> coforge_stack::leds::Leds {
-        Node::leds(self)
-    }
+/// A plain generated node has no board to inject faults into.
+impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Console for Node<D, S, N, P> {}
+
+/// A running device, whatever its type.
+pub trait SimDevice: Device + Console + Send {}
+
+impl<T: Device + Console + Send> SimDevice for T {}
+
+/// The spec emergency called `name` in the node's mode (fault injection by name).
+pub fn emergency(node: &dyn NodeAccess, name: &str) -> Option<&'static EmcyDefault> {
+    node.emergencies().iter().find(|e| e.name == name)
 }
 
-/// Where a simulated device keeps its parameters.
+/// Raises the spec emergency called `name`; `false` if there is none.
+pub fn raise(device: &mut dyn SimDevice, name: &str) -> bool {
+    let found = emergency(device.node(), name);
+    found.map(|e| device.node_mut().raise(e)).is_some()
+}
+
+/// Ends the spec emergency called `name`; `false` if there is none.
+pub fn clear(device: &mut dyn SimDevice, name: &str) -> bool {
+    let found = emergency(device.node(), name);
+    found.map(|e| device.node_mut().clear(e)).is_some()
+}
+
+/// Where a simulated device keeps its non-volatile memory.
 #[derive(Debug, Clone, Default)]
 pub enum StoreAt {
     /// In memory: survives NMT resets, not a restart of the simulator.
     #[default]
     Memory,
-    /// In a file.
+    /// In files: the plain node's parameters in the file itself, any other memory in
+    /// `FILE.<name>` (CO401Memory1's banks in `FILE.bank1` and `FILE.bank2`).
     File(PathBuf),
 }
 
-/// Builds a node of one device: mode name, node-ID, where its non-volatile memory lives.
-type Build = fn(Option<&str>, u8, &StoreAt) -> Result<Box<dyn SimNode>, String>;
+/// The EEPROM a device asks for, at `store`.
+pub fn eeprom(store: &StoreAt, request: MemoryRequest) -> Result<Eeprom, String> {
+    match store {
+        StoreAt::Memory => Ok(Eeprom::new(request.capacity)),
+        StoreAt::File(path) => {
+            let mut name = path.clone().into_os_string();
+            if request.name != "parameters" {
+                name.push(format!(".{}", request.name));
+            }
+            let path = PathBuf::from(name);
+            Eeprom::with_file(request.capacity, &path).map_err(|e| format!("{}: {e}", path.display()))
+        }
+    }
+}
+
+/// Builds a device: its name, mode name, node-ID, where its non-volatile memory lives.
+type Build = fn(&'static str, Option<&str>, u8, &StoreAt) -> Result<Box<dyn SimDevice>, String>;
 
 /// A device the simulator can run.
 #[derive(Debug, Clone, Copy)]
@@ -110,58 +88,46 @@ pub struct DeviceKind {
     build: Build,
 }
 
-/// An EEPROM of `capacity` bytes at `store`; `suffix` tells several apart in one file name.
-pub fn eeprom(store: &StoreAt, capacity: usize, suffix: &str) -> Result<MemStorage, String> {
-    match store {
-        StoreAt::Memory => Ok(MemStorage::new(capacity)),
-        StoreAt::File(path) => {
-            let mut name = path.clone().into_os_string();
-            name.push(suffix);
-            let path = PathBuf::from(name);
-            MemStorage::with_file(capacity, &path).map_err(|e| format!("{}: {e}", path.display()))
-        }
-    }
-}
-
-macro_rules! device_kind {
-    ($krate:ident) => {
-        DeviceKind {
-            name: stringify!($krate),
-            build: |mode, node_id, store| {
-                let mode = match mode {
-                    None => $krate::Mode::ALL[0],
-                    Some(name) => $krate::Mode::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
-                        let known: Vec<&str> = $krate::Mode::ALL.iter().map(|m| m.name()).collect();
-                        format!("{} has no mode `{name}`; its modes are: {}", stringify!($krate), known.join(", "))
-                    })?,
-                };
-                let size = <$krate::Od<RamApp> as NodeDictionary>::PERSISTENT_SIZE;
-                let storage = eeprom(store, BlockStore::<MemStorage>::capacity_for(size), "")?;
-                let od = $krate::Od::new(mode, node_id, RamApp::default());
-                let node: $krate::Node<RamApp, BlockStore<MemStorage>> = Node::new(od, BlockStore::new(storage, 0), $krate::node_config(node_id));
-                Ok(Box::new(node))
-            },
-        }
-    };
-}
-
-/// Every device, by crate name.
-pub const DEVICES: [DeviceKind; 4] =
-    [DeviceKind { name: "co401memory1", build: crate::memory1::build }, device_kind!(co401gw1), device_kind!(cr3101), device_kind!(canopenia)];
-
 impl DeviceKind {
+    /// Device type `T` under `name`.
+    pub const fn of<T: Assemble<Eeprom> + Console + Send + 'static>(name: &'static str) -> DeviceKind {
+        DeviceKind { name, build: build::<T> }
+    }
+
     pub fn find(name: &str) -> Result<DeviceKind, String> {
-        DEVICES.into_iter().find(|d| d.name == name).ok_or_else(|| {
+        DEVICES.iter().find(|d| d.name == name).copied().ok_or_else(|| {
             let known: Vec<&str> = DEVICES.iter().map(|d| d.name).collect();
             format!("unknown device `{name}`; known devices: {}", known.join(", "))
         })
     }
 
-    /// A node of this device, not started yet.
-    pub fn create(&self, mode: Option<&str>, node_id: u8, store: &StoreAt) -> Result<Box<dyn SimNode>, String> {
-        if !(1..=127).contains(&node_id) {
-            return Err(format!("node-ID {node_id} is outside 1..=127"));
+    /// A device of this kind, not started yet.
+    pub fn create(&self, mode: Option<&str>, node_id: u8, store: &StoreAt) -> Result<Box<dyn SimDevice>, String> {
+        (self.build)(self.name, mode, node_id, store)
+    }
+}
+
+fn build<T: Assemble<Eeprom> + Console + Send + 'static>(
+    name: &'static str,
+    mode: Option<&str>,
+    node_id: u8,
+    store: &StoreAt,
+) -> Result<Box<dyn SimDevice>, String> {
+    // Checked first, so that no file is created for a device that cannot run.
+    if !(1..=127).contains(&node_id) {
+        return Err(format!("node-ID {node_id} is outside 1..=127"));
+    }
+    let mut file_error = None;
+    let mut memory = |request| eeprom(store, request).map_err(|e| file_error = Some(e)).ok();
+    match T::assemble(mode, node_id, &mut memory) {
+        Ok(device) => Ok(Box::new(device)),
+        Err(AssembleError::UnknownMode) => {
+            let mut known = Vec::new();
+            T::mode_names(&mut |m| known.push(m));
+            Err(format!("{name} has no mode `{}`; its modes are: {}", mode.unwrap_or_default(), known.join(", ")))
         }
-        (self.build)(mode, node_id, store)
+        Err(AssembleError::NodeId) => Err(format!("node-ID {node_id} is outside 1..=127")),
+        Err(AssembleError::NoMemory(what)) => Err(file_error.unwrap_or_else(|| format!("{name}: no {what} memory"))),
+        Err(AssembleError::Config(why)) => Err(format!("{name}: {why}")),
     }
 }

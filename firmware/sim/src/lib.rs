@@ -3,12 +3,12 @@
 //!
 //! - [`slcan`]: the Lawicel ASCII protocol, an encoder and a streaming decoder that never panics;
 //! - [`hub`]: the bus, a TCP SLCAN listener plus in-process [`hub::Port`]s;
-//! - [`devices`]: the four coforge devices as [`devices::SimNode`]s, by name;
-//! - [`memory1`]: CO401Memory1's own board (pins, supply) and console commands;
+//! - [`devices`]: the coforge devices by name, built and driven through the device contract;
+//! - [`memory1`]: CO401Memory1's console commands (supply, corrupt, outputs);
 //! - [`runner`]: real-time nodes on a hub, one thread for all of them;
 //! - [`serial`]: a device's serial host interface on a TCP port;
 //! - [`vbus`]: a deterministic in-process bus on a virtual clock, for tests;
-//! - [`storage`], [`app`]: parameter storage (memory or file) and app-backed objects.
+//! - [`storage`], [`app`]: EEPROMs (memory or file) and app-backed objects.
 #![forbid(unsafe_code)]
 #![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
 #![cfg_attr(test, allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used, clippy::panic))]

@@ -1,7 +1,7 @@
 //! Runs simulated nodes in real time on a hub: one thread steps every node, so a full
 //! 127-node bus costs one thread, not 127.
 
-use crate::devices::SimNode;
+use crate::devices::SimDevice;
 use crate::hub::{Hub, Port};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -25,8 +25,11 @@ pub struct Stats {
 /// Input for a running node other than CAN frames: its serial host, and the console.
 #[derive(Debug)]
 pub enum Input {
-    /// A byte from the node's serial host, received at `at`; answers go to `reply`.
-    Serial { node: usize, byte: u8, at: Instant, reply: Sender<Vec<u8>> },
+    /// A serial host connected to the node: what the node sends its host goes to `output`
+    /// from now on (no longer to an earlier host).
+    HostConnected { node: usize, output: Sender<Vec<u8>> },
+    /// A byte from the node's serial host, received at `at`.
+    HostByte { node: usize, byte: u8, at: Instant },
     /// A console command (fault injection); the outcome goes to `reply`.
     Control { node: usize, command: String, reply: Sender<Result<String, String>> },
 }
@@ -74,7 +77,7 @@ impl Drop for Running {
 /// Starts `nodes` on `hub`, each on its own port, stepped by one thread. Returns once every
 /// node has booted and its boot-up message is on the bus, so a client that connects after
 /// this never sees a boot-up it did not cause.
-pub fn spawn(hub: &Hub, nodes: Vec<Box<dyn SimNode>>) -> Running {
+pub fn spawn(hub: &Hub, nodes: Vec<Box<dyn SimDevice>>) -> Running {
     let ports: Vec<Port> = nodes.iter().map(|_| hub.attach()).collect();
     let stop = Arc::new(AtomicBool::new(false));
     let stats = Arc::new(Stats::default());
@@ -89,11 +92,11 @@ pub fn spawn(hub: &Hub, nodes: Vec<Box<dyn SimNode>>) -> Running {
     Running { stop, thread, stats, inputs }
 }
 
-fn run(mut nodes: Vec<Box<dyn SimNode>>, ports: Vec<Port>, stop: &AtomicBool, stats: &Stats, booted: &Sender<()>, inputs: &Receiver<Input>) {
+fn run(mut nodes: Vec<Box<dyn SimDevice>>, ports: Vec<Port>, stop: &AtomicBool, stats: &Stats, booted: &Sender<()>, inputs: &Receiver<Input>) {
     let epoch = Instant::now();
-    let now_us = || u64::try_from(epoch.elapsed().as_micros()).unwrap_or(u64::MAX);
     // Serial bytes carry their arrival time, so a pause between them is seen as the host made it.
-    let ms_at = |at: Instant| u32::try_from(at.saturating_duration_since(epoch).as_millis() % (1 << 32)).unwrap_or(0);
+    let us_at = |at: Instant| u64::try_from(at.saturating_duration_since(epoch).as_micros()).unwrap_or(u64::MAX);
+    let now_us = || us_at(Instant::now());
     for (node, port) in nodes.iter_mut().zip(&ports) {
         node.start(now_us());
         while let Some(frame) = node.poll(now_us()) {
@@ -101,26 +104,31 @@ fn run(mut nodes: Vec<Box<dyn SimNode>>, ports: Vec<Port>, stop: &AtomicBool, st
         }
     }
     let _ = booted.send(());
+    // Where each node's serial output goes: its connected host, if any.
+    let mut hosts: Vec<Option<Sender<Vec<u8>>>> = vec![None; nodes.len()];
     while !stop.load(Ordering::Relaxed) {
         let started = Instant::now();
         let mut busy = false;
         while let Ok(input) = inputs.try_recv() {
             busy = true;
             match input {
-                Input::Serial { node, byte, at, reply } => {
-                    let mut out = [0_u8; 32];
-                    let n = nodes.get_mut(node).map_or(0, |n| n.serial_byte(byte, ms_at(at), &mut out));
-                    if n > 0 {
-                        let _ = reply.send(out.get(..n).unwrap_or(&[]).to_vec());
+                Input::HostConnected { node, output } => {
+                    if let Some(host) = hosts.get_mut(node) {
+                        *host = Some(output);
+                    }
+                }
+                Input::HostByte { node, byte, at } => {
+                    if let Some(port) = nodes.get_mut(node).and_then(|n| n.host_port()) {
+                        port.on_host_byte(byte, us_at(at));
                     }
                 }
                 Input::Control { node, command, reply } => {
-                    let outcome = nodes.get_mut(node).map_or_else(|| Err(format!("no node {node}")), |n| n.control(&command));
+                    let outcome = nodes.get_mut(node).map_or_else(|| Err(format!("no node {node}")), |n| n.console(&command));
                     let _ = reply.send(outcome);
                 }
             }
         }
-        for (node, port) in nodes.iter_mut().zip(&ports) {
+        for ((node, port), host) in nodes.iter_mut().zip(&ports).zip(&mut hosts) {
             while let Some(frame) = port.try_recv() {
                 node.on_frame(&frame, now_us());
                 stats.frames_in.fetch_add(1, Ordering::Relaxed);
@@ -130,6 +138,15 @@ fn run(mut nodes: Vec<Box<dyn SimNode>>, ports: Vec<Port>, stop: &AtomicBool, st
                 port.send(frame);
                 stats.frames_out.fetch_add(1, Ordering::Relaxed);
                 busy = true;
+            }
+            // Answers, late answers and unsolicited output alike; without a host they are lost,
+            // as on an unconnected UART.
+            let mut out = [0_u8; 64];
+            while let Some(n) = node.host_port().map(|p| p.host_output(now_us(), &mut out)).filter(|&n| n > 0) {
+                busy = true;
+                if host.as_ref().is_some_and(|h| h.send(out.get(..n).unwrap_or(&[]).to_vec()).is_err()) {
+                    *host = None;
+                }
             }
         }
         stats.steps.fetch_add(1, Ordering::Relaxed);

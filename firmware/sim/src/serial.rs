@@ -1,6 +1,9 @@
 //! A simulated device's serial host interface on a TCP port (one client at a time), so a host
 //! program or pyserial (`serial_for_url("socket://127.0.0.1:PORT")`) talks to it as to the
-//! module's RS232 pins.
+//! module's RS232 pins. Bytes go to the device's [`HostPort`] with their arrival time; the
+//! runner polls the device's output and sends it to the client whenever there is some.
+//!
+//! [`HostPort`]: coforge_stack::device::HostPort
 
 use crate::runner::Input;
 use std::io::{Read, Write};
@@ -36,10 +39,15 @@ pub fn serve(addr: impl ToSocketAddrs, node: usize, inputs: Sender<Input>) -> st
 fn client(stream: TcpStream, node: usize, inputs: &Sender<Input>) {
     let _ = stream.set_nodelay(true);
     let Ok(mut writer) = stream.try_clone() else { return };
-    let (reply, answers) = channel::<Vec<u8>>();
-    let sender = std::thread::spawn(move || {
-        for answer in answers {
-            if writer.write_all(&answer).is_err() {
+    let (output, bytes) = channel::<Vec<u8>>();
+    if inputs.send(Input::HostConnected { node, output }).is_err() {
+        return;
+    }
+    // Ends when the client is gone, or when the runner drops `output` (the next client
+    // connected, the simulation stopped).
+    let _ = std::thread::Builder::new().name("coforge-serial-out".into()).spawn(move || {
+        for chunk in bytes {
+            if writer.write_all(&chunk).is_err() {
                 break;
             }
         }
@@ -52,11 +60,9 @@ fn client(stream: TcpStream, node: usize, inputs: &Sender<Input>) {
         }
         let at = Instant::now();
         for &byte in buf.get(..n).unwrap_or(&[]) {
-            if inputs.send(Input::Serial { node, byte, at, reply: reply.clone() }).is_err() {
+            if inputs.send(Input::HostByte { node, byte, at }).is_err() {
                 return;
             }
         }
     }
-    drop(reply);
-    let _ = sender.join();
 }

@@ -1,6 +1,7 @@
-//! Parameter storage for simulated devices: an EEPROM image in memory, optionally mirrored
-//! to a file so stored parameters survive restarting the simulator.
+//! Non-volatile memory of simulated devices: an EEPROM image in RAM, optionally mirrored to a
+//! file so stored data survives restarting the simulator.
 
+use coforge_storage::ram::RamEeprom;
 use embedded_storage::{ReadStorage, Storage};
 use std::fs::File;
 use std::io::{Seek, SeekFrom, Write};
@@ -15,15 +16,15 @@ pub enum StorageError {
 
 /// A byte-addressable store of `capacity` bytes, erased to 0xFF like an EEPROM.
 #[derive(Debug)]
-pub struct MemStorage {
-    bytes: Vec<u8>,
+pub struct Eeprom {
+    ram: RamEeprom<Vec<u8>>,
     /// Written through at the same offsets, so a save costs what it writes, not the file.
     file: Option<File>,
 }
 
-impl MemStorage {
+impl Eeprom {
     pub fn new(capacity: usize) -> Self {
-        MemStorage { bytes: vec![0xFF; capacity], file: None }
+        Eeprom { ram: RamEeprom::erased(vec![0; capacity]), file: None }
     }
 
     /// Backed by `path`: loaded from it if it exists, written through on every write.
@@ -36,13 +37,7 @@ impl MemStorage {
         bytes.resize(capacity, 0xFF);
         let mut file = std::fs::OpenOptions::new().create(true).truncate(false).write(true).open(path)?;
         file.write_all(&bytes)?;
-        Ok(MemStorage { bytes, file: Some(file) })
-    }
-
-    fn range(&self, offset: u32, len: usize) -> Result<std::ops::Range<usize>, StorageError> {
-        let start = usize::try_from(offset).map_err(|_| StorageError::OutOfBounds)?;
-        let end = start.checked_add(len).ok_or(StorageError::OutOfBounds)?;
-        if end > self.bytes.len() { Err(StorageError::OutOfBounds) } else { Ok(start..end) }
+        Ok(Eeprom { ram: RamEeprom::holding(bytes), file: Some(file) })
     }
 }
 
@@ -52,24 +47,21 @@ impl embedded_storage::nor_flash::NorFlashError for StorageError {
     }
 }
 
-impl ReadStorage for MemStorage {
+impl ReadStorage for Eeprom {
     type Error = StorageError;
 
     fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), StorageError> {
-        let r = self.range(offset, bytes.len())?;
-        bytes.copy_from_slice(self.bytes.get(r).ok_or(StorageError::OutOfBounds)?);
-        Ok(())
+        self.ram.read(offset, bytes).map_err(|_| StorageError::OutOfBounds)
     }
 
     fn capacity(&self) -> usize {
-        self.bytes.len()
+        self.ram.capacity()
     }
 }
 
-impl Storage for MemStorage {
+impl Storage for Eeprom {
     fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), StorageError> {
-        let r = self.range(offset, bytes.len())?;
-        self.bytes.get_mut(r).ok_or(StorageError::OutOfBounds)?.copy_from_slice(bytes);
+        self.ram.write(offset, bytes).map_err(|_| StorageError::OutOfBounds)?;
         if let Some(file) = &mut self.file {
             file.seek(SeekFrom::Start(u64::from(offset))).and_then(|_| file.write_all(bytes)).map_err(|e| StorageError::File(e.to_string()))?;
         }

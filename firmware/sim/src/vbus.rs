@@ -2,12 +2,12 @@
 //! Every frame a node or the test sends reaches every other party; time only moves when the
 //! test says so.
 
-use crate::devices::SimNode;
+use crate::devices::SimDevice;
 use coforge_stack::frame::CanFrame;
 
 /// Nodes plus one test "master" on a virtual bus.
 pub struct VirtualBus {
-    pub nodes: Vec<Box<dyn SimNode>>,
+    pub nodes: Vec<Box<dyn SimDevice>>,
     now_us: u64,
     /// Frames the nodes sent that the master has not taken yet.
     to_master: std::collections::VecDeque<CanFrame>,
@@ -23,7 +23,7 @@ impl std::fmt::Debug for VirtualBus {
 
 impl VirtualBus {
     /// Starts every node at time 0 (their boot-up messages go on the bus).
-    pub fn new(nodes: Vec<Box<dyn SimNode>>) -> Self {
+    pub fn new(nodes: Vec<Box<dyn SimDevice>>) -> Self {
         let mut bus = VirtualBus { nodes, now_us: 0, to_master: Default::default(), log: Vec::new() };
         for n in &mut bus.nodes {
             n.start(0);

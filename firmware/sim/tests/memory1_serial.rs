@@ -20,8 +20,8 @@ fn exchange(stream: &mut TcpStream, request: &[u8], len: usize) -> Vec<u8> {
 #[test]
 fn the_serial_host_and_the_console_reach_the_running_module() {
     let hub = Hub::bind("127.0.0.1:0").unwrap();
-    let node = DeviceKind::find("co401memory1").unwrap().create(None, 9, &StoreAt::Memory).unwrap();
-    assert!(node.has_serial());
+    let mut node = DeviceKind::find("co401memory1").unwrap().create(None, 9, &StoreAt::Memory).unwrap();
+    assert!(node.host_port().is_some());
     let running = coforge_sim::runner::spawn(&hub, vec![node]);
     let port = coforge_sim::serial::serve("127.0.0.1:0", 0, running.inputs()).unwrap();
     let mut host = TcpStream::connect(port.local_addr()).unwrap();
@@ -60,15 +60,15 @@ fn banks_kept_in_files_survive_a_restart_of_the_simulated_module() {
     let kind = DeviceKind::find("co401memory1").unwrap();
     let mut node = kind.create(None, 3, &store).unwrap();
     node.start(0);
-    node.write(0x5010, 0x80, &[0x5A], Side::Bus).unwrap();
+    node.node_mut().write(0x5010, 0x80, &[0x5A], Side::Bus).unwrap();
     drop(node);
     assert!(dir.join("banks.bank1").exists() && dir.join("banks.bank2").exists());
     let mut node = kind.create(None, 3, &store).unwrap();
     node.start(0);
     let mut value = [0];
-    node.read(0x5010, 0x80, &mut value).unwrap();
+    node.node_mut().read(0x5010, 0x80, 0, &mut value, Side::Device).unwrap();
     assert_eq!(value, [0x5A]);
-    node.read(0x6000, 1, &mut value).unwrap();
+    node.node_mut().read(0x6000, 1, 0, &mut value, Side::Device).unwrap();
     assert_eq!(value, [0], "a clean restart reports nothing");
     std::fs::remove_dir_all(&dir).unwrap();
 }

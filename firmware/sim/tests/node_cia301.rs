@@ -3,14 +3,14 @@
 
 #![allow(clippy::unwrap_used)]
 
-use coforge_sim::devices::{DeviceKind, SimNode, StoreAt};
+use coforge_sim::devices::{DeviceKind, SimDevice, StoreAt};
 use coforge_sim::vbus::VirtualBus;
 use coforge_stack::frame::CanFrame;
 use coforge_stack::nmt::NmtState;
 
 const ID: u8 = 5;
 
-fn node(device: &str) -> Box<dyn SimNode> {
+fn node(device: &str) -> Box<dyn SimDevice> {
     DeviceKind::find(device).unwrap().create(None, ID, &StoreAt::Memory).unwrap()
 }
 
@@ -88,22 +88,22 @@ fn u32_of(v: &[u8]) -> u32 {
 #[test]
 fn nmt_states_and_what_they_allow() {
     let mut bus = bus("co401gw1");
-    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational);
+    assert_eq!(bus.nodes[0].node().state(), NmtState::PreOperational);
     nmt(&mut bus, 0x01);
-    assert_eq!(bus.nodes[0].state(), NmtState::Operational);
+    assert_eq!(bus.nodes[0].node().state(), NmtState::Operational);
     nmt(&mut bus, 0x02);
-    assert_eq!(bus.nodes[0].state(), NmtState::Stopped);
+    assert_eq!(bus.nodes[0].node().state(), NmtState::Stopped);
     bus.send(frame(0x605, &[0x40, 0x00, 0x10, 0, 0, 0, 0, 0]));
     assert!(bus.drain().is_empty(), "no SDO in Stopped");
     nmt(&mut bus, 0x80);
-    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational);
+    assert_eq!(bus.nodes[0].node().state(), NmtState::PreOperational);
     bus.send(frame(0x000, &[0x01, ID + 1]));
-    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational, "addressed to another node");
+    assert_eq!(bus.nodes[0].node().state(), NmtState::PreOperational, "addressed to another node");
     bus.send(frame(0x000, &[0x01, 0]));
-    assert_eq!(bus.nodes[0].state(), NmtState::Operational, "broadcast");
+    assert_eq!(bus.nodes[0].node().state(), NmtState::Operational, "broadcast");
     nmt(&mut bus, 0x82);
     assert_eq!(bus.drain(), vec![frame(0x705, &[0])], "reset communication boots again");
-    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational);
+    assert_eq!(bus.nodes[0].node().state(), NmtState::PreOperational);
 }
 
 #[test]
@@ -147,7 +147,7 @@ fn node_guarding_and_life_guarding_emcy() {
     bus.advance_ms(301);
     let emcy: Vec<CanFrame> = bus.drain().into_iter().filter(|f| f.id == 0x85).collect();
     assert_eq!(emcy, vec![frame(0x85, &[0x30, 0x81, 0x01, 0, 0, 0, 0, 0x30])], "life guarding error from the spec");
-    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational, "1029 sub 1 = 0: operational -> pre-operational");
+    assert_eq!(bus.nodes[0].node().state(), NmtState::PreOperational, "1029 sub 1 = 0: operational -> pre-operational");
     assert_eq!(upload(&mut bus, 0x1001, 0).unwrap(), vec![0x01]);
     bus.send(rtr);
     let after: Vec<CanFrame> = bus.drain();
@@ -172,7 +172,7 @@ fn tpdo_remapping_and_transmission_types() {
     download(&mut bus, 0x1800, 1, &cob.to_le_bytes()).unwrap();
     nmt(&mut bus, 0x01);
     bus.drain();
-    bus.nodes[0].write(0x6000, 1, &[0xAB], coforge_stack::od::Side::Device).unwrap();
+    bus.nodes[0].node_mut().write(0x6000, 1, &[0xAB], coforge_stack::od::Side::Device).unwrap();
     let sync = frame(0x080, &[]);
     bus.send(sync);
     assert!(bus.drain().is_empty(), "first SYNC of two");
@@ -231,7 +231,7 @@ fn sync_cycle_monitoring_from_1006() {
 
 /// CO401GW1 with CiA 301 4.2 RPDO deadline monitoring switched on (the chip itself has it off,
 /// erratum GW1-13), to check the stack's monitor.
-fn gw1_with_rpdo_deadlines() -> Box<dyn SimNode> {
+fn gw1_with_rpdo_deadlines() -> Box<dyn SimDevice> {
     use coforge_sim::app::RamApp;
     use coforge_stack::store::NoStore;
     let config = coforge_stack::node::NodeConfig { rpdo_deadlines: true, ..co401gw1::node_config(ID) };
@@ -279,7 +279,7 @@ fn boot_up_message_can_be_switched_off_by_2110() {
     download(&mut bus, 0x2110, 0, &[0]).unwrap();
     nmt(&mut bus, 0x82);
     assert!(bus.drain().is_empty(), "no boot-up with 2110h = 0");
-    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational);
+    assert_eq!(bus.nodes[0].node().state(), NmtState::PreOperational);
     download(&mut bus, 0x2110, 0, &[1]).unwrap();
     nmt(&mut bus, 0x82);
     assert_eq!(bus.drain(), vec![frame(0x705, &[0])]);
@@ -296,7 +296,7 @@ fn bus_off_restart_and_return_emergency() {
     while bus.nodes[0].take_event().is_some() {}
     let now = bus.now_us();
     bus.nodes[0].on_bus_state(BusState::BusOff, now);
-    assert_eq!(bus.nodes[0].state(), NmtState::PreOperational, "1029h sub 1 = 0: a communication error leaves Operational");
+    assert_eq!(bus.nodes[0].node().state(), NmtState::PreOperational, "1029h sub 1 = 0: a communication error leaves Operational");
     assert_eq!(bus.nodes[0].leds().error, LedState::On, "CiA 303-3: bus-off lights the error LED");
     bus.advance_ms(999);
     assert!(bus.drain().is_empty(), "nothing is sent while bus-off");
@@ -325,12 +325,12 @@ fn timers_near_the_end_of_the_clock_do_not_overflow() {
     let mut n = node("co401gw1");
     let t = u64::MAX - 1_000;
     n.start(t);
-    n.write(0x1017, 0, &100_u16.to_le_bytes(), Side::Bus).unwrap();
-    n.write(0x1800, 5, &10_u16.to_le_bytes(), Side::Bus).unwrap();
-    n.write(0x1400, 5, &10_u16.to_le_bytes(), Side::Bus).unwrap();
+    n.node_mut().write(0x1017, 0, &100_u16.to_le_bytes(), Side::Bus).unwrap();
+    n.node_mut().write(0x1800, 5, &10_u16.to_le_bytes(), Side::Bus).unwrap();
+    n.node_mut().write(0x1400, 5, &10_u16.to_le_bytes(), Side::Bus).unwrap();
     n.on_frame(&frame(0x000, &[0x01, ID]), t);
     n.on_frame(&frame(0x205, &[0; 8]), t);
-    n.trigger_tpdo(1);
+    n.node_mut().trigger_tpdo(1);
     let mut sent = 0;
     // Deadlines saturate at u64::MAX (584 000 years of microseconds) instead of overflowing.
     for now in [t, t + 500] {
@@ -339,5 +339,24 @@ fn timers_near_the_end_of_the_clock_do_not_overflow() {
         }
     }
     assert!(sent >= 2, "boot-up and the TPDO go out ({sent})");
-    assert_eq!(n.state(), NmtState::Operational);
+    assert_eq!(n.node().state(), NmtState::Operational);
+}
+
+#[test]
+fn the_registry_names_devices_modes_and_spec_emergencies() {
+    let create = |device: &str, mode: Option<&str>, id: u8| DeviceKind::find(device).and_then(|k| k.create(mode, id, &StoreAt::Memory)).err();
+    assert_eq!(create("co401gw2", None, ID).unwrap(), "unknown device `co401gw2`; known devices: co401memory1, co401gw1, cr3101, canopenia");
+    assert_eq!(create("co401gw1", Some("analog"), ID).unwrap(), "co401gw1 has no mode `analog`; its modes are: mixed, digital, digital_alt");
+    assert_eq!(create("co401memory1", Some("mixed"), ID).unwrap(), "co401memory1 has no mode `mixed`; its modes are: default");
+    assert_eq!(create("cr3101", None, 0).unwrap(), "node-ID 0 is outside 1..=127");
+    assert_eq!(create("co401gw1", Some("digital"), ID), None);
+
+    let mut bus = bus("co401gw1");
+    assert!(coforge_sim::devices::raise(&mut *bus.nodes[0], "application_emergency_0"));
+    bus.advance_ms(1);
+    assert_eq!(emcy_frames(&mut bus), vec![[0x10, 0x23, 0x01, 0, 0x01, 0, 0, 0]], "the spec's frame");
+    assert!(coforge_sim::devices::clear(&mut *bus.nodes[0], "application_emergency_0"));
+    bus.advance_ms(1);
+    assert_eq!(emcy_frames(&mut bus), vec![[0; 8]], "error reset");
+    assert!(!coforge_sim::devices::raise(&mut *bus.nodes[0], "no_such_emergency"));
 }

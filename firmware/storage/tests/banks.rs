@@ -5,7 +5,7 @@
 use coforge_storage::ram::RamEeprom;
 use coforge_storage::{BankStatus, Error, MirroredBanks};
 
-type Banks = MirroredBanks<RamEeprom<8448>, 64, 128>;
+type Banks = MirroredBanks<RamEeprom<[u8; 8448]>, 64, 128>;
 
 fn blank() -> Banks {
     Banks::mount([RamEeprom::new(), RamEeprom::new()])
@@ -87,7 +87,7 @@ fn rewriting_stored_bytes_writes_nothing() {
 /// A RAM EEPROM whose writes can be made to fail (an I2C device that stops acknowledging).
 #[derive(Debug, Clone, Default)]
 struct Flaky {
-    ram: RamEeprom<8448>,
+    ram: RamEeprom<[u8; 8448]>,
     refuse_writes: bool,
 }
 

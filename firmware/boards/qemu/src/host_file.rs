@@ -5,7 +5,7 @@
 //! Reads come from the bank's image in RAM; every write changes the image and goes to the
 //! file at once, at the same offset, so the file is always what the EEPROM would hold.
 
-use coforge_storage::ram::BorrowedEeprom;
+use coforge_storage::ram::RamEeprom;
 use cortex_m_semihosting::{nr, syscall};
 use embedded_storage::{ReadStorage, Storage};
 
@@ -16,7 +16,7 @@ pub struct HostFileError;
 /// One bank: its RAM image and the open host file behind it.
 #[derive(Debug)]
 pub struct HostFileEeprom<'a> {
-    ram: BorrowedEeprom<'a>,
+    ram: RamEeprom<&'a mut [u8]>,
     handle: usize,
 }
 
@@ -38,7 +38,7 @@ impl<'a> HostFileEeprom<'a> {
         if existing != usize::MAX {
             let loaded = call(nr::FLEN, [existing]) == image.len() && call(nr::READ, [existing, image.as_mut_ptr() as usize, image.len()]) == 0;
             if loaded {
-                return Ok(HostFileEeprom { ram: BorrowedEeprom::holding(image), handle: existing });
+                return Ok(HostFileEeprom { ram: RamEeprom::holding(image), handle: existing });
             }
             call(nr::CLOSE, [existing]);
         }
@@ -46,7 +46,7 @@ impl<'a> HostFileEeprom<'a> {
         if handle == usize::MAX {
             return Err(HostFileError);
         }
-        let mut bank = HostFileEeprom { ram: BorrowedEeprom::erased(image), handle };
+        let mut bank = HostFileEeprom { ram: RamEeprom::erased(image), handle };
         let len = bank.ram.capacity();
         bank.write_file(0, len)?;
         Ok(bank)

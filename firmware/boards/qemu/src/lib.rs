@@ -1,6 +1,7 @@
 //! The lm3s6965evb board as QEMU emulates it: a millisecond clock from SysTick, the two UARTs
-//! the images use, banks kept in host files through semihosting, and the main loop the
-//! CO401Memory1 images share. The module itself is the device crate's.
+//! the images use, banks kept in host files through semihosting, and the main loop every
+//! image runs its device in (`serve`, generic over the device contract). The devices are the
+//! device crates'; each image builds its own.
 #![no_std]
 
 pub mod clock;

@@ -1,26 +1,32 @@
-//! The images' main loop: the serial host protocol on UART0, the module's CAN side as an
-//! SLCAN adapter on UART1 (frames a host sends are what the node receives, frames the node
-//! sends come back as SLCAN lines).
+//! The images' main loop, for any device: its serial host port (if it has one) on UART0, its
+//! CAN side as an SLCAN adapter on UART1 (frames a host sends are what the node receives,
+//! frames the node sends come back as SLCAN lines).
 
 use crate::clock;
 use crate::uart::{UART0, UART1, Uart};
-use co401memory1::{FixedBoard, Memory1};
 use coforge_slcan::{self as slcan, Command};
-use embedded_storage::Storage;
+use coforge_stack::device::Device;
 
-/// Starts the module and serves both UARTs for ever.
-pub fn run<S: Storage>(device: &mut Memory1<S, FixedBoard>) -> ! {
+/// Starts the clock and the device and serves both UARTs for ever.
+pub fn serve<D: Device>(device: &mut D) -> ! {
+    let Some(core) = cortex_m::Peripherals::take() else { panic!("peripherals taken twice") };
+    clock::start(core.SYST);
     let (host, can) = (Uart::new(UART0), Uart::new(UART1));
     device.start(0);
     let mut lines = slcan::Decoder::new();
-    let mut answer = [0_u8; 16];
     let mut line = [0_u8; slcan::MAX_FRAME_LINE];
     loop {
-        let ms = clock::millis();
-        let now_us = u64::from(ms) * 1000;
-        while let Some(byte) = host.read() {
-            let n = device.on_serial_byte(byte, ms, &mut answer);
-            host.write(answer.get(..n).unwrap_or(&[]));
+        let now_us = clock::millis() * 1000;
+        if let Some(port) = device.host_port() {
+            while let Some(byte) = host.read() {
+                port.on_host_byte(byte, now_us);
+            }
+            // Polled on every pass, not only after a byte: answers may come late or unasked.
+            // One byte at a time: the UART sends no faster anyway.
+            let mut byte = [0];
+            while port.host_output(now_us, &mut byte) == 1 {
+                host.write(&byte);
+            }
         }
         while let Some(byte) = can.read() {
             if let Some(cmd) = lines.push(byte) {
@@ -35,26 +41,4 @@ pub fn run<S: Storage>(device: &mut Memory1<S, FixedBoard>) -> ! {
             can.write(line.get(..n).unwrap_or(&[]));
         }
     }
-}
-
-/// The body of each CO401Memory1 image's `main`: takes the core peripherals, starts the
-/// clock, builds the module on `banks` (node-ID 5 on the pins, 1 Mbit/s, 9600 baud, 24 V) in
-/// a `MaybeUninit` static and serves it. A macro, since `singleton!` needs the module's
-/// concrete type (an `Option` static would sit in .data: a second copy of it in flash). The
-/// module is built in a function of its own, so that its construction's temporaries (about
-/// 1.3 KiB) leave the stack before the loop starts.
-#[macro_export]
-macro_rules! serve_memory1 {
-    ($storage:ty, $banks:expr) => {{
-        type Device = co401memory1::Memory1<$storage, co401memory1::FixedBoard>;
-        #[inline(never)]
-        fn mount(banks: [$storage; 2]) -> &'static mut Device {
-            let Ok(device) = co401memory1::Memory1::new(banks, co401memory1::FixedBoard::new(5)) else { panic!("reserved configuration pins") };
-            let Some(device) = cortex_m::singleton!(: Device = device) else { panic!("started twice") };
-            device
-        }
-        let Some(core) = cortex_m::Peripherals::take() else { panic!("peripherals taken twice") };
-        $crate::clock::start(core.SYST);
-        $crate::serve::run(mount($banks))
-    }};
 }

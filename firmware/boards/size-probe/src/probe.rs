@@ -1,44 +1,48 @@
-//! One image per device: its CANopen node (the generated dictionary and every protocol
-//! engine of coforge-stack, fed frames from the bus) and, if the device has one, its serial
-//! codecs (deframe, decode, encode). `black_box` keeps everything from being optimised away.
+//! What each image measures, for any device: its CANopen node (the generated dictionary and
+//! every protocol engine of coforge-stack, fed frames from the bus), its serial host port if
+//! it has one, and for a plain node the serial codecs of its spec (deframe, decode, encode).
+//! `black_box` keeps everything from being optimised away.
+#![no_std]
 
-/// `probe!(device, node_id)` or `probe!(device, node_id, serial)`.
-macro_rules! probe {
-    ($device:ident, $node_id:expr $(, $serial:ident)?) => {
-        use coforge_stack::frame::CanFrame;
-        use coforge_stack::od::NoAppObjects;
-        use coforge_stack::store::NoStore;
-        use core::hint::black_box;
-        use panic_halt as _;
+use coforge_link::{Deframer, Message, SerialCodec};
+use coforge_stack::device::Device;
+use coforge_stack::frame::CanFrame;
+use core::hint::black_box;
 
-        #[cortex_m_rt::entry]
-        fn main() -> ! {
-            let od = $device::Od::new(black_box($device::Mode::ALL[0]), black_box($node_id), NoAppObjects);
-            let node = coforge_stack::node::Node::new(od, NoStore, $device::node_config($node_id));
-            // The node lives in .bss (a `MaybeUninit` static), so the size report shows its
-            // static RAM and no copy of it in flash.
-            let Some(node) = cortex_m::singleton!(: $device::Node<NoAppObjects, NoStore> = node) else { loop {} };
-            node.start(0);
-            let mut now = 0_u64;
-            #[allow(unused_mut, unused_variables)]
-            let mut buf = [0_u8; 64];
-            $(let mut decoder = $device::$serial::decoder();)?
-            loop {
-                now += 1000;
-                let frame = CanFrame { id: black_box(0x601), rtr: black_box(false), dlc: 8, data: black_box([0x40, 0x18, 0x10, 1, 0, 0, 0, 0]) };
-                node.on_frame(&frame, now);
-                while let Some(out) = node.poll(now) {
-                    black_box(out);
-                }
-                $(
-                    use coforge_link::Deframer as _;
-                    if let Some(Ok(frame)) = decoder.push(black_box(0x11), black_box(0))
-                        && let Ok(cmd) = $device::$serial::HostToDevice::decode(&frame)
-                    {
-                        let _ = black_box(cmd.encode(&mut buf));
-                    }
-                )?
-            }
+/// Drives `device` for ever.
+pub fn run<D: Device>(device: &'static mut D) -> ! {
+    drive(device, || {})
+}
+
+/// Drives `device` for ever, and the codecs `C` beside it.
+pub fn run_with_codec<D: Device, C: SerialCodec>(device: &'static mut D) -> ! {
+    let mut decoder = C::decoder();
+    let mut buf = [0_u8; 64];
+    drive(device, move || {
+        if let Some(Ok(frame)) = decoder.push(black_box(0x11), black_box(0))
+            && let Ok(cmd) = C::HostToDevice::decode(&frame)
+        {
+            let _ = black_box(cmd.encode(&mut buf));
         }
-    };
+    })
+}
+
+fn drive<D: Device>(device: &'static mut D, mut codec: impl FnMut()) -> ! {
+    device.start(0);
+    let mut now = 0_u64;
+    let mut out = [0_u8; 16];
+    loop {
+        now += 1000;
+        let frame = CanFrame { id: black_box(0x605), rtr: black_box(false), dlc: 8, data: black_box([0x40, 0x18, 0x10, 1, 0, 0, 0, 0]) };
+        device.on_frame(&frame, now);
+        while let Some(sent) = device.poll(now) {
+            black_box(sent);
+        }
+        if let Some(port) = device.host_port() {
+            port.on_host_byte(black_box(0x33), now);
+            let n = port.host_output(now, &mut out);
+            black_box(out.get(..n));
+        }
+        codec();
+    }
 }

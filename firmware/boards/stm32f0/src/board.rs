@@ -134,7 +134,8 @@ impl Board for Stm32Board {
     /// A new conversion (about 20 us with 239.5-cycle sampling for the divider's 9 kOhm
     /// source) at most every 10 ms.
     fn supply_mv(&mut self) -> u16 {
-        let now = clock::millis();
+        // The low 32 bits: a wrapping difference is all this needs.
+        let now = clock::millis() as u32;
         match self.supply {
             Some((mv, at)) if now.wrapping_sub(at) < SUPPLY_REFRESH_MS => mv,
             _ => {

@@ -14,7 +14,7 @@ pub struct MsDelay;
 impl MsDelay {
     fn wait_ms(ms: u32) {
         let start = millis();
-        while millis().wrapping_sub(start) <= ms {}
+        while millis().wrapping_sub(start) <= u64::from(ms) {}
     }
 }
 

@@ -35,10 +35,12 @@
 //! The datasheet's inversions (ID, BD, RSBD and CFG active low) are applied by the device
 //! crate's decoders: [`board::ConfigWord`] hands over raw levels.
 #![no_std]
-#![forbid(unsafe_code)]
+// One read of a status register (`serve::esr`) is the only `unsafe`.
+#![deny(unsafe_code)]
 #![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
 
 pub mod board;
 pub mod can;
 pub mod clock;
 pub mod i2c;
+pub mod serve;

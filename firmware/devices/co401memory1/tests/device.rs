@@ -8,7 +8,7 @@ use coforge_stack::device::{Device, HostPort};
 use coforge_stack::frame::CanFrame;
 use coforge_storage::ram::RamEeprom;
 
-type Eeprom = RamEeprom<BANK_SIZE>;
+type Eeprom = RamEeprom<[u8; BANK_SIZE]>;
 type Dev = Memory1<Eeprom, FixedBoard>;
 
 const NODE: u16 = 5;

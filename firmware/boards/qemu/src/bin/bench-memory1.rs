@@ -17,22 +17,23 @@
 #![no_std]
 #![no_main]
 
-use co401memory1::{BANK_SIZE, FixedBoard, Memory1};
+use co401memory1::{BANK_SIZE, ConfigError, FixedBoard, Memory1};
+use coforge_stack::device::{Device, HostPort};
 use coforge_stack::frame::CanFrame;
 use coforge_stack::od::Side;
-use coforge_storage::ram::BorrowedEeprom;
+use coforge_storage::ram::RamEeprom;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
 
-type Device = Memory1<BorrowedEeprom<'static>, FixedBoard>;
+type Bank = RamEeprom<&'static mut [u8; BANK_SIZE]>;
+type Module = Memory1<Bank, FixedBoard>;
 
 const NODE_ID: u8 = 5;
 const SDO_RX: u16 = 0x600 + NODE_ID as u16;
 const SDO_TX: u16 = 0x580 + NODE_ID as u16;
 /// One fixed time for every input: no timer (scrub at 1 s, event timers) runs in between.
 const NOW_US: u64 = 10_000;
-const NOW_MS: u32 = 10;
 /// Stack words painted with this pattern count as never used.
 const PAINT: u32 = 0xC0DE_57AC;
 /// Bytes below the stack pointer at painting time that are left alone (the painting loop's
@@ -71,12 +72,12 @@ fn frame(id: u16, data: &[u8]) -> CanFrame {
 }
 
 /// Hands one frame to the module and polls until it is quiet.
-fn exchange(device: &mut Device, input: &CanFrame) -> Answers {
+fn exchange(device: &mut Module, input: &CanFrame) -> Answers {
     device.on_frame(input, NOW_US);
     drain(device)
 }
 
-fn drain(device: &mut Device) -> Answers {
+fn drain(device: &mut Module) -> Answers {
     let mut answers = Answers { frames: [frame(0, &[]); 4], n: 0 };
     while let Some(f) = device.poll(NOW_US) {
         if let Some(slot) = answers.frames.get_mut(answers.n) {
@@ -138,7 +139,7 @@ fn expect(what: &str, answers: &Answers, expected: &[(u16, &[u8])]) {
 
 /// An expedited SDO download done during setup (not measured); fails on anything but the
 /// confirmation.
-fn sdo_write(device: &mut Device, index: u16, sub: u8, value: &[u8]) {
+fn sdo_write(device: &mut Module, index: u16, sub: u8, value: &[u8]) {
     let [lo, hi] = index.to_le_bytes();
     let command = 0x23 | ((4 - value.len() as u8) << 2);
     let mut request = [command, lo, hi, sub, 0, 0, 0, 0];
@@ -189,12 +190,14 @@ fn stack_peak() -> usize {
     top - at
 }
 
-/// Builds the module into a `MaybeUninit` static, in a frame of its own: the construction's
-/// temporaries are gone when it returns, instead of staying in `main`'s frame for ever.
+/// Builds the module right in a `MaybeUninit` static (not moved in), in a frame of its own:
+/// the construction's temporaries are gone when it returns, instead of staying in `main`'s
+/// frame for ever.
 #[inline(never)]
-fn mount(banks: [BorrowedEeprom<'static>; 2]) -> &'static mut Device {
-    let Ok(device) = Memory1::new(banks, FixedBoard::new(NODE_ID)) else { panic!("reserved configuration pins") };
-    let Some(device) = cortex_m::singleton!(: Device = device) else { panic!("mounted twice") };
+fn mount(banks: [Bank; 2]) -> &'static mut Module {
+    let Some(Ok(device)) = cortex_m::singleton!(: Result<Module, ConfigError> = Memory1::new(banks, FixedBoard::new(NODE_ID))) else {
+        panic!("mounted twice, or reserved configuration pins")
+    };
     device
 }
 
@@ -203,7 +206,7 @@ fn main() -> ! {
     static mut BANK1: [u8; BANK_SIZE] = [0; BANK_SIZE];
     static mut BANK2: [u8; BANK_SIZE] = [0; BANK_SIZE];
     paint_stack();
-    let device = mount([BorrowedEeprom::erased(BANK1), BorrowedEeprom::erased(BANK2)]);
+    let device = mount([RamEeprom::erased(BANK1), RamEeprom::erased(BANK2)]);
 
     // Unmeasured setup. Boot-up, then the EMCYs of the freshly cleared banks (status 0x40).
     device.start(0);
@@ -272,11 +275,10 @@ fn main() -> ! {
     let command = [0x33, 0x12, 0x50, 0x04];
     let mut out = [0_u8; 16];
     let n = measure(7, || {
-        let mut n = 0;
         for &byte in &command {
-            n = device.on_serial_byte(byte, NOW_MS, &mut out);
+            device.on_host_byte(byte, NOW_US);
         }
-        n
+        device.host_output(NOW_US, &mut out)
     });
     if out.get(..n) != Some(&[0x32, 0x01, 0x23][..]) {
         hprintln!("bench: serial answer {:02x?}", out.get(..n).unwrap_or(&[]));

@@ -12,10 +12,13 @@
 #![no_std]
 #![no_main]
 
-use co401memory1::BANK_SIZE;
+use co401memory1::{BANK_SIZE, ConfigError, FixedBoard, Memory1};
 use coforge_board_qemu::host_file::HostFileEeprom;
+use coforge_board_qemu::serve::serve;
 use cortex_m_rt::entry;
 use panic_semihosting as _;
+
+type Device = Memory1<HostFileEeprom<'static>, FixedBoard>;
 
 #[entry]
 fn main() -> ! {
@@ -25,5 +28,14 @@ fn main() -> ! {
     let (Ok(bank1), Ok(bank2)) = (HostFileEeprom::open("co401memory1.bank1\0", BANK1), HostFileEeprom::open("co401memory1.bank2\0", BANK2)) else {
         panic!("cannot open the bank files (is semihosting enabled?)")
     };
-    coforge_board_qemu::serve_memory1!(HostFileEeprom<'static>, [bank1, bank2])
+    serve(mount([bank1, bank2]))
+}
+
+/// The module in a static, built in a frame of its own (see `co401memory1`).
+#[inline(never)]
+fn mount(banks: [HostFileEeprom<'static>; 2]) -> &'static mut Device {
+    let Some(Ok(device)) = cortex_m::singleton!(: Result<Device, ConfigError> = Memory1::new(banks, FixedBoard::new(5))) else {
+        panic!("started twice, or reserved configuration pins")
+    };
+    device
 }

@@ -1,9 +1,22 @@
-//! co401gw1: what its generated code costs in flash (see `src/probe.rs`).
+//! co401gw1: what its generated code costs in flash (see `src/probe.rs`): its node and serial codecs.
 #![no_std]
 #![no_main]
 
-#[macro_use]
-#[path = "../probe.rs"]
-mod probe;
+use coforge_stack::node::Node;
+use coforge_stack::od::NoAppObjects;
+use coforge_stack::store::NoStore;
+use core::hint::black_box;
+use panic_halt as _;
 
-probe!(co401gw1, 5, serial);
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    // In .bss (a `MaybeUninit` static), so the size report shows its static RAM and no copy
+    // of it in flash.
+    let node = Node::of_dictionary(black_box(co401gw1::Mode::ALL[0]), black_box(5), NoAppObjects, NoStore);
+    let Some(node) = cortex_m::singleton!(: co401gw1::Node<NoAppObjects, NoStore> = node) else {
+        loop {
+            cortex_m::asm::wfi()
+        }
+    };
+    probe::run_with_codec::<_, co401gw1::serial::Codec>(node)
+}

@@ -1,9 +1,22 @@
-//! cr3101: what its generated code costs in flash (see `src/probe.rs`).
+//! cr3101: what its generated code costs in flash (see `src/probe.rs`): its node.
 #![no_std]
 #![no_main]
 
-#[macro_use]
-#[path = "../probe.rs"]
-mod probe;
+use coforge_stack::node::Node;
+use coforge_stack::od::NoAppObjects;
+use coforge_stack::store::NoStore;
+use core::hint::black_box;
+use panic_halt as _;
 
-probe!(cr3101, 0x20);
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    // In .bss (a `MaybeUninit` static), so the size report shows its static RAM and no copy
+    // of it in flash.
+    let node = Node::of_dictionary(black_box(cr3101::Mode::ALL[0]), black_box(0x20), NoAppObjects, NoStore);
+    let Some(node) = cortex_m::singleton!(: cr3101::Node<NoAppObjects, NoStore> = node) else {
+        loop {
+            cortex_m::asm::wfi()
+        }
+    };
+    probe::run(node)
+}

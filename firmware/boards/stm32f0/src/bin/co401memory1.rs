@@ -8,23 +8,19 @@
 #![no_main]
 #![deny(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used)]
 
-use co401memory1::Memory1;
+use co401memory1::{ConfigError, Memory1};
 use coforge_board_stm32f0::board::{ConfigChain, StatusPins, Stm32Board};
+use coforge_board_stm32f0::serve::serve;
 use coforge_board_stm32f0::{can, clock, i2c::I2cBus};
-use coforge_stack::node::BusState;
 use core::cell::RefCell;
 use core::mem::MaybeUninit;
 use cortex_m_rt::entry;
 use eeprom24x::{Eeprom24x, SlaveAddr, Storage};
 use embedded_hal_02::digital::v2::OutputPin;
-use embedded_hal_02::serial::{Read, Write};
 use embedded_hal_bus::i2c::RefCellDevice;
 use panic_halt as _;
 use stm32f0xx_hal::can::CanInstance;
 use stm32f0xx_hal::can::bxcan::{self, filter::Mask32};
-use stm32f0xx_hal::gpio::gpioa::{PA2, PA3, PA11, PA12};
-use stm32f0xx_hal::gpio::gpiob::{PB0, PB1};
-use stm32f0xx_hal::gpio::{AF1, AF4, Alternate, Output, PushPull};
 use stm32f0xx_hal::i2c::I2c;
 use stm32f0xx_hal::pac;
 use stm32f0xx_hal::prelude::*;
@@ -33,12 +29,6 @@ use stm32f0xx_hal::serial::Serial;
 /// One bank: a 24C128 (16 KiB, 64-byte pages, two address bytes) on the shared bus.
 type Bank = Storage<RefCellDevice<'static, I2cBus>, eeprom24x::page_size::B64, eeprom24x::addr_size::TwoBytes, eeprom24x::unique_serial::No, clock::MsDelay>;
 type Device = Memory1<Bank, Stm32Board>;
-type Host = Serial<pac::USART2, PA2<Alternate<AF1>>, PA3<Alternate<AF1>>>;
-type Can = bxcan::Can<CanInstance<PA12<Alternate<AF4>>, PA11<Alternate<AF4>>>>;
-/// CANLEDR#, CANLEDE#.
-type Leds = (PB0<Output<PushPull>>, PB1<Output<PushPull>>);
-/// Answers of the serial host protocol are at most this long.
-const ANSWER: usize = 16;
 
 #[entry]
 fn main() -> ! {
@@ -47,7 +37,7 @@ fn main() -> ! {
     // `None` of the module is not all zeros, which would put its 1.9 KiB in .data, i.e. also
     // in flash; `MaybeUninit::write` is safe and hands out the `&'static mut`.
     static mut BUS: MaybeUninit<RefCell<I2cBus>> = MaybeUninit::uninit();
-    static mut DEVICE: MaybeUninit<Device> = MaybeUninit::uninit();
+    static mut DEVICE: MaybeUninit<Result<Device, ConfigError>> = MaybeUninit::uninit();
     let (Some(core), Some(mut p)) = (cortex_m::Peripherals::take(), pac::Peripherals::take()) else { panic!("peripherals taken twice") };
 
     #[cfg(not(feature = "hsi48"))]
@@ -101,99 +91,14 @@ fn main() -> ! {
     // power-on must not stop the serial host. ABOM (set here) restarts after bus-off by itself.
     let _ = bxcan.enable_non_blocking();
 
-    run(device, host, bxcan, leds)
+    serve(device, host, bxcan, leds)
 }
 
-/// The main loop. Not inlined either: the device's handlers inlined here have frames of their
-/// own, which must not add to `mount`'s (see there).
-#[inline(never)]
-fn run(device: &'static mut Device, mut host: Host, mut bxcan: Can, mut leds: Leds) -> ! {
-    device.start(0);
-    let mut answer = [0_u8; ANSWER];
-    // A frame the mailboxes did not take (all three busy with frames of higher or equal
-    // priority, or one bxcan took out to make room): sent before anything new is polled.
-    let mut held: Option<bxcan::Frame> = None;
-    let mut bus_state = BusState::Active;
-    let (mut last_ms, mut now_ms) = (clock::millis(), 0_u64);
-    loop {
-        let ms = clock::millis();
-        // A 64-bit time that does not wrap after 49 days as the 32-bit counter does.
-        now_ms += u64::from(ms.wrapping_sub(last_ms));
-        last_ms = ms;
-        let now_us = now_ms * 1000;
-
-        loop {
-            match host.read() {
-                Ok(byte) => {
-                    let n = device.on_serial_byte(byte, ms, &mut answer);
-                    for &b in answer.get(..n).unwrap_or(&[]) {
-                        let _ = nb::block!(host.write(b));
-                    }
-                }
-                // Framing, noise, overrun: the flag is cleared, the byte (if any) comes next.
-                Err(nb::Error::Other(_)) => {}
-                Err(nb::Error::WouldBlock) => break,
-            }
-        }
-
-        loop {
-            match bxcan.receive() {
-                Ok(frame) => {
-                    if let Some(frame) = can::from_bxcan(&frame) {
-                        device.on_frame(&frame, now_us);
-                    }
-                }
-                // A FIFO overrun: frames were lost, the rest are still there.
-                Err(nb::Error::Other(())) => {}
-                Err(nb::Error::WouldBlock) => break,
-            }
-        }
-
-        let state = can::bus_state(esr(&mut bxcan));
-        if state != bus_state {
-            bus_state = state;
-            device.on_bus_state(state, now_us);
-        }
-
-        if let Some(frame) = held.take() {
-            held = transmit(&mut bxcan, frame);
-        }
-        while held.is_none() {
-            let Some(frame) = device.poll(now_us) else { break };
-            held = can::to_bxcan(&frame).and_then(|f| transmit(&mut bxcan, f));
-        }
-
-        // The 32-bit milliseconds: a u64 here would link a 64-bit division (about 1 KiB) for
-        // the patterns' periods; the wrap after 49 days only shifts a flash phase once.
-        let indicators = device.node().leds();
-        let _ = leds.0.set_state((!indicators.run.level(u64::from(ms))).into());
-        let _ = leds.1.set_state((!indicators.error.level(u64::from(ms))).into());
-    }
-}
-
-/// Builds the module (reading the configuration, mounting the banks) into `slot`. Not inlined:
+/// Builds the module (reading the configuration, mounting the banks) right in `slot`, not on
+/// the stack to be moved there (about 100 bytes less code). Not inlined:
 /// the module's construction moves some kilobytes of temporaries, and in `main` they would keep
 /// that much of the 6 KiB stack for ever; here they are gone when it returns.
 #[inline(never)]
-fn mount(slot: &'static mut MaybeUninit<Device>, banks: [Bank; 2], board: Stm32Board) -> Option<&'static mut Device> {
-    match Memory1::new(banks, board) {
-        Ok(device) => Some(slot.write(device)),
-        Err(_) => None,
-    }
-}
-
-/// Queues `frame`; returns what could not be queued: `frame` itself, or the lower-priority
-/// frame bxcan aborted to make room for it.
-fn transmit<I: bxcan::Instance>(can: &mut bxcan::Can<I>, frame: bxcan::Frame) -> Option<bxcan::Frame> {
-    match can.transmit(&frame) {
-        Ok(status) => status.dequeued_frame().cloned(),
-        Err(_) => Some(frame),
-    }
-}
-
-/// CAN_ESR: the controller's error state (bxcan 0.6 has no accessor for it).
-fn esr(can: &mut Can) -> u32 {
-    // SAFETY: a read of a read-only status register, without side effects; bxcan owns the
-    // peripheral but never writes ESR's read-only bits, and nothing else runs concurrently.
-    unsafe { can.instance().peripheral() }.esr.read().bits()
+fn mount(slot: &'static mut MaybeUninit<Result<Device, ConfigError>>, banks: [Bank; 2], board: Stm32Board) -> Option<&'static mut Device> {
+    slot.write(Memory1::new(banks, board)).as_mut().ok()
 }

@@ -1,0 +1,105 @@
+//! The main loop, for any device: its serial host port (if it has one) on USART2, its CAN
+//! side on bxCAN, its CiA 303-3 indicators on the two LEDs.
+
+use crate::{can, clock};
+use coforge_stack::device::Device;
+use coforge_stack::node::BusState;
+use embedded_hal_02::digital::v2::OutputPin;
+use embedded_hal_02::serial::{Read, Write};
+use stm32f0xx_hal::can::CanInstance;
+use stm32f0xx_hal::can::bxcan;
+use stm32f0xx_hal::gpio::gpioa::{PA2, PA3, PA11, PA12};
+use stm32f0xx_hal::gpio::gpiob::{PB0, PB1};
+use stm32f0xx_hal::gpio::{AF1, AF4, Alternate, Output, PushPull};
+use stm32f0xx_hal::pac;
+use stm32f0xx_hal::serial::Serial;
+
+/// The serial host: USART2 on PA2/PA3.
+pub type Host = Serial<pac::USART2, PA2<Alternate<AF1>>, PA3<Alternate<AF1>>>;
+/// bxCAN on PA12/PA11.
+pub type Can = bxcan::Can<CanInstance<PA12<Alternate<AF4>>, PA11<Alternate<AF4>>>>;
+/// CANLEDR#, CANLEDE#.
+pub type Leds = (PB0<Output<PushPull>>, PB1<Output<PushPull>>);
+
+/// Starts the device and serves it for ever. Not inlined: the device's handlers inlined here
+/// have frames of their own, which must not add to the frame that built the device.
+#[inline(never)]
+pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut leds: Leds) -> ! {
+    device.start(0);
+    // A frame the mailboxes did not take (all three busy with frames of higher or equal
+    // priority, or one bxcan took out to make room): sent before anything new is polled.
+    let mut held: Option<bxcan::Frame> = None;
+    let mut bus_state = BusState::Active;
+    loop {
+        let now_ms = clock::millis();
+        let now_us = now_ms * 1000;
+
+        if let Some(port) = device.host_port() {
+            loop {
+                match host.read() {
+                    Ok(byte) => port.on_host_byte(byte, now_us),
+                    // Framing, noise, overrun: the flag is cleared, the byte (if any) comes next.
+                    Err(nb::Error::Other(_)) => {}
+                    Err(nb::Error::WouldBlock) => break,
+                }
+            }
+            // Polled on every pass, not only after a byte: answers may come late or unasked.
+            // One byte at a time: the UART sends no faster anyway.
+            let mut byte = [0];
+            while port.host_output(now_us, &mut byte) == 1 {
+                let _ = nb::block!(host.write(byte[0]));
+            }
+        }
+
+        loop {
+            match bxcan.receive() {
+                Ok(frame) => {
+                    if let Some(frame) = can::from_bxcan(&frame) {
+                        device.on_frame(&frame, now_us);
+                    }
+                }
+                // A FIFO overrun: frames were lost, the rest are still there.
+                Err(nb::Error::Other(())) => {}
+                Err(nb::Error::WouldBlock) => break,
+            }
+        }
+
+        let state = can::bus_state(esr(&mut bxcan));
+        if state != bus_state {
+            bus_state = state;
+            device.on_bus_state(state, now_us);
+        }
+
+        if let Some(frame) = held.take() {
+            held = transmit(&mut bxcan, frame);
+        }
+        while held.is_none() {
+            let Some(frame) = device.poll(now_us) else { break };
+            held = can::to_bxcan(&frame).and_then(|f| transmit(&mut bxcan, f));
+        }
+
+        // The milliseconds' low 32 bits: a u64 here would link a 64-bit division (about 1 KiB)
+        // for the patterns' periods; the wrap after 49 days only shifts a flash phase once.
+        let ms = u64::from(now_ms as u32);
+        let indicators = device.leds();
+        let _ = leds.0.set_state((!indicators.run.level(ms)).into());
+        let _ = leds.1.set_state((!indicators.error.level(ms)).into());
+    }
+}
+
+/// Queues `frame`; returns what could not be queued: `frame` itself, or the lower-priority
+/// frame bxcan aborted to make room for it.
+fn transmit<I: bxcan::Instance>(can: &mut bxcan::Can<I>, frame: bxcan::Frame) -> Option<bxcan::Frame> {
+    match can.transmit(&frame) {
+        Ok(status) => status.dequeued_frame().cloned(),
+        Err(_) => Some(frame),
+    }
+}
+
+/// CAN_ESR: the controller's error state (bxcan 0.6 has no accessor for it).
+#[allow(unsafe_code)]
+fn esr(can: &mut Can) -> u32 {
+    // SAFETY: a read of a read-only status register, without side effects; bxcan owns the
+    // peripheral but never writes ESR's read-only bits, and nothing else runs concurrently.
+    unsafe { can.instance().peripheral() }.esr.read().bits()
+}
