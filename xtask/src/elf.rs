@@ -95,3 +95,36 @@ pub fn symbol(elf: &[u8], name: &str) -> Result<u32, String> {
     }
     Err(format!("no symbol `{name}` in the symbol table"))
 }
+
+/// One entry of the symbol table that occupies memory: a function or an object.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Symbol {
+    pub name: String,
+    pub addr: u32,
+    pub size: u32,
+    /// The section it lives in (`.text`, `.rodata`, `.bss`...).
+    pub section: String,
+}
+
+/// Every function and object symbol with a size, from `.symtab`.
+pub fn symbols(elf: &[u8]) -> Result<Vec<Symbol>, String> {
+    const SHT_SYMTAB: u32 = 2;
+    const STT_OBJECT: u8 = 1;
+    const STT_FUNC: u8 = 2;
+    let sections = sections(elf)?;
+    let mut out = Vec::new();
+    for table in sections.iter().filter(|s| s.kind == SHT_SYMTAB && s.entsize >= 16) {
+        let strings = sections.get(table.link as usize).ok_or("symbol table without string table")?.offset;
+        for sym in (table.offset..table.offset + table.size as usize).step_by(table.entsize as usize) {
+            let info = elf.get(sym + 12).copied().ok_or("truncated symbol table")?;
+            let shndx = usize::from(u16_at(elf, sym + 14).ok_or("truncated symbol table")?);
+            let size = field(elf, sym + 8)?;
+            if size == 0 || !matches!(info & 0xF, STT_OBJECT | STT_FUNC) {
+                continue;
+            }
+            let Some(section) = sections.get(shndx) else { continue };
+            out.push(Symbol { name: string_at(elf, strings + field(elf, sym)? as usize), addr: field(elf, sym + 4)?, size, section: section.name.clone() });
+        }
+    }
+    Ok(out)
+}

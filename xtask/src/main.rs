@@ -9,6 +9,7 @@ mod elf;
 mod images;
 mod setup;
 mod size;
+mod symbols;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -18,12 +19,15 @@ fn main() -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("dist") => dist(),
         Some("test") => test(),
-        Some("size") => setup::rust_targets().and_then(|()| size::report()),
+        Some("size") => setup::rust_targets().and_then(|()| match args.get(1).map(String::as_str) {
+            Some("--symbols") => symbols::report(args.get(2..).unwrap_or_default()),
+            _ => size::report(),
+        }),
         Some("flash") => images::flash(args.get(1..).unwrap_or_default()),
         Some("bench") => bench::main(args.get(1..).unwrap_or_default()),
         _ => {
             eprintln!(
-                "usage: cargo xtask <dist|test|size|flash>\n  dist   check every spec; write EDS files, docs and firmware images into target/dist/\n  test   install missing tools, then run the whole test suite\n  size   flash and RAM of each device's generated code on a Cortex-M0\n  flash  --device <d> --board <b> [--chip <c>]: write an image with probe-rs"
+                "usage: cargo xtask <dist|test|size|flash>\n  dist   check every spec; write EDS files, docs and firmware images into target/dist/\n  test   install missing tools, then run the whole test suite\n  size   flash and RAM of each device's generated code on a Cortex-M0\n         --symbols <device | image.elf> [count]: its largest symbols and flash per module\n  flash  --device <d> --board <b> [--chip <c>]: write an image with probe-rs"
             );
             return ExitCode::from(2);
         }

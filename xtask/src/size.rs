@@ -2,6 +2,7 @@
 //! (thumbv6m-none-eabi, opt-level "z", LTO), measured against an image without it.
 
 use crate::{Result, root, run};
+use std::path::PathBuf;
 use std::process::Command;
 
 /// Sizes of the allocated sections of an ELF32 little-endian image.
@@ -41,6 +42,19 @@ pub fn sections(elf: &[u8]) -> std::result::Result<Sections, String> {
     Ok(s)
 }
 
+/// The devices with a size-probe image.
+pub const DEVICES: [&str; 4] = ["co401memory1", "co401gw1", "cr3101", "canopenia"];
+
+/// Builds the size-probe images (`firmware/boards/size-probe`).
+pub fn build_probes() -> Result {
+    run(Command::new("cargo").args(["build", "--quiet", "--release", "--target", "thumbv6m-none-eabi"]).current_dir(root().join("firmware/boards/size-probe")))
+}
+
+/// The size-probe image of `device` (or `baseline`).
+pub fn probe_elf(device: &str) -> PathBuf {
+    root().join("firmware/boards/size-probe/target/thumbv6m-none-eabi/release").join(device)
+}
+
 /// Prints [`table`].
 pub fn report() -> Result {
     for line in table()?.lines() {
@@ -51,9 +65,8 @@ pub fn report() -> Result {
 
 /// The size of each device's code above the baseline image, as text lines.
 pub fn table() -> Result<String> {
-    let dir = root().join("firmware/boards/size-probe");
-    run(Command::new("cargo").args(["build", "--quiet", "--release", "--target", "thumbv6m-none-eabi"]).current_dir(&dir))?;
-    let bin = |name: &str| dir.join("target/thumbv6m-none-eabi/release").join(name);
+    build_probes()?;
+    let bin = probe_elf;
     let read = |name: &str| -> Result<Sections> {
         let bytes = std::fs::read(bin(name)).map_err(|e| format!("cannot read {}: {e}", bin(name).display()))?;
         sections(&bytes).map_err(|e| format!("{name}: {e}"))
@@ -61,7 +74,7 @@ pub fn table() -> Result<String> {
     let base = read("baseline")?;
     let mut out = format!("generated code on thumbv6m-none-eabi (opt-level z, LTO), above a {}-byte baseline image:\n", base.flash());
     out.push_str(&format!("{:<14} {:>8} {:>8} {:>10} {:>10}\n", "device", ".text", ".rodata", "flash", "static RAM"));
-    for device in ["co401memory1", "co401gw1", "cr3101", "canopenia"] {
+    for device in DEVICES {
         let s = read(device)?;
         let text = s.text.saturating_sub(base.text);
         let rodata = s.rodata.saturating_sub(base.rodata);
