@@ -61,16 +61,12 @@ pub fn emcy_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream 
             quote!(#[doc = #doc] pub const #c: #stack::emcy::EmcyDefault = #value;)
         })
         .collect();
-    let mut statics = Vec::new();
-    let mut per_mode = Vec::new();
-    for (variant, mode) in &modes.variants {
-        let list: Vec<TokenStream> = d.emergencies.iter().filter(|e| in_mode(&e.modes, mode.as_deref())).map(|e| emergency(e, stack)).collect();
-        let count = crate::dec(list.len() as u64);
-        let name = format_ident!("EMCY_{}", variant.to_string().to_uppercase());
-        statics.push(quote!(static #name: [#stack::emcy::EmcyDefault; #count] = [#(#list),*];));
-        per_mode.push(quote!(&#name));
-    }
-    let select = modes.select(&per_mode);
+    let per_mode: Vec<Vec<TokenStream>> = modes
+        .variants
+        .iter()
+        .map(|(_, mode)| d.emergencies.iter().filter(|e| in_mode(&e.modes, mode.as_deref())).map(|e| emergency(e, stack)).collect())
+        .collect();
+    let (statics, select) = modes.tables("EMCY", &quote!(#stack::emcy::EmcyDefault), &per_mode);
     quote! {
         /// The spec's emergencies.
         pub mod emcy {

@@ -170,17 +170,15 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
 pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let stack = &options.stack;
     let mut limits: Vec<LimitsKey> = Vec::new();
-    let mut tables = Vec::new();
-    let mut per_mode = Vec::new();
     let numbers = crate::dictionary::object_numbers(d);
-    for (variant, mode) in &modes.variants {
-        let runs = runs(d, mode.as_deref());
-        let count = crate::dec(runs.len() as u64);
-        let table = format_ident!("ENTRIES_{}", variant.to_string().to_uppercase());
-        let items: Vec<TokenStream> = runs.iter().map(|r| run_tokens(r, numbers.get(&r.index).copied().unwrap_or_default(), stack, &mut limits)).collect();
-        tables.push(quote! { static #table: [#stack::od::EntryInfo; #count] = [#(#items),*]; });
-        per_mode.push(quote!(&#table));
-    }
+    let per_mode: Vec<Vec<TokenStream>> = modes
+        .variants
+        .iter()
+        .map(|(_, mode)| {
+            runs(d, mode.as_deref()).iter().map(|r| run_tokens(r, numbers.get(&r.index).copied().unwrap_or_default(), stack, &mut limits)).collect()
+        })
+        .collect();
+    let (tables, select) = modes.tables("ENTRIES", &quote!(#stack::od::EntryInfo), &per_mode);
     let limit_statics = limits.iter().enumerate().map(|(n, (low, high, values))| {
         let name = format_ident!("LIMITS_{}", n);
         let opt = |v: &Option<i64>| match v {
@@ -194,7 +192,6 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
         let (low, high) = (opt(low), opt(high));
         quote! { static #name: #stack::od::Limits = #stack::od::Limits { low: #low, high: #high, values: &[#(#values),*] }; }
     });
-    let select = modes.select(&per_mode);
     // The SDO server buffers a download until its last segment: size the buffer for the
     // largest value the bus may write. Domains without a declared length do not count; a
     // download larger than the buffer is refused with "out of memory".
