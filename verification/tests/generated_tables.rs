@@ -86,3 +86,31 @@ fn canopenia_tables_match_the_spec() {
     let d = spec("canopenia.yaml");
     check(&d, None, od::entries(Mode::Default), pdo::rpdos(Mode::Default), pdo::tpdos(Mode::Default));
 }
+
+/// The host-only name lookup: every spec emergency of every mode is found by its name, and
+/// names nothing else.
+#[test]
+fn emergencies_are_found_by_their_spec_names() {
+    macro_rules! check_names {
+        ($krate:ident, $spec:literal) => {{
+            use $krate::{Mode, emcy};
+            let d = spec($spec);
+            for mode in Mode::ALL {
+                let spec_mode = (Mode::ALL.len() > 1).then(|| mode.name());
+                let listed: Vec<_> = d.emergencies.iter().filter(|e| in_mode(&e.modes, spec_mode)).collect();
+                assert_eq!(listed.len(), emcy::emergencies(mode).len(), "{} {mode:?}", $spec);
+                for (e, generated) in listed.iter().zip(emcy::emergencies(mode)) {
+                    let found = emcy::by_name(mode, &e.name).unwrap_or_else(|| panic!("{} {mode:?}: {} not found", $spec, e.name));
+                    assert_eq!(found, *generated, "{} {mode:?}: {}", $spec, e.name);
+                    assert_eq!((found.code, found.register), (e.code, e.error_register), "{}", e.name);
+                    assert_eq!(emcy::name_of(mode, generated), Some(e.name.as_str()));
+                }
+                assert_eq!(emcy::by_name(mode, "no_such_emergency"), None);
+            }
+        }};
+    }
+    check_names!(co401memory1, "co401memory1.yaml");
+    check_names!(co401gw1, "co401gw1.yaml");
+    check_names!(cr3101, "cr3101.yaml");
+    check_names!(canopenia, "canopenia.yaml");
+}

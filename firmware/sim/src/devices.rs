@@ -5,7 +5,7 @@ use crate::storage::MemStorage;
 use coforge_stack::emcy::EmcyDefault;
 use coforge_stack::frame::CanFrame;
 use coforge_stack::node::{BusState, Node, NodeEvent};
-use coforge_stack::od::{NodeDictionary, ReadLen, SdoAbort, Side};
+use coforge_stack::od::{AppObjects, NodeDictionary, ReadLen, SdoAbort, Side};
 use coforge_stack::store::{BlockStore, ParamStore};
 use std::path::PathBuf;
 
@@ -42,9 +42,27 @@ pub trait SimNode: Send {
     }
 }
 
+/// A generated dictionary's emergencies by spec name (the device's `emcy::by_name` in the
+/// dictionary's mode): the names live on the host only.
+pub trait EmcyByName {
+    fn emcy_by_name(&self, name: &str) -> Option<EmcyDefault>;
+}
+
+macro_rules! emcy_by_name {
+    ($($krate:ident),*) => {
+        $(impl<A: AppObjects> EmcyByName for $krate::Od<A> {
+            fn emcy_by_name(&self, name: &str) -> Option<EmcyDefault> {
+                $krate::emcy::by_name(self.mode(), name)
+            }
+        })*
+    };
+}
+
+emcy_by_name!(co401memory1, co401gw1, cr3101, canopenia);
+
 impl<D, S, const N: usize, const P: usize> SimNode for Node<D, S, N, P>
 where
-    D: NodeDictionary + Send,
+    D: NodeDictionary + EmcyByName + Send,
     S: ParamStore + Send,
 {
     fn start(&mut self, now_us: u64) {
@@ -69,11 +87,11 @@ where
         Node::write(self, index, sub, data, side)
     }
     fn raise(&mut self, name: &str) -> bool {
-        let found: Option<EmcyDefault> = self.od().emergencies().iter().find(|e| e.name == name).copied();
+        let found = self.od().emcy_by_name(name);
         found.map(|e| Node::raise(self, &e)).is_some()
     }
     fn clear(&mut self, name: &str) -> bool {
-        let found: Option<EmcyDefault> = self.od().emergencies().iter().find(|e| e.name == name).copied();
+        let found = self.od().emcy_by_name(name);
         found.map(|e| Node::clear(self, &e)).is_some()
     }
     fn on_bus_state(&mut self, bus: BusState, now_us: u64) {

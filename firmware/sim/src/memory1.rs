@@ -45,11 +45,11 @@ impl SimNode for SimMemory1 {
         self.node_mut().write(index, sub, data, side)
     }
     fn raise(&mut self, name: &str) -> bool {
-        let found = co401memory1::emcy::emergencies(co401memory1::Mode::Default).iter().find(|e| e.name == name).copied();
+        let found = co401memory1::emcy::by_name(co401memory1::Mode::Default, name);
         found.map(|e| self.node_mut().raise(&e)).is_some()
     }
     fn clear(&mut self, name: &str) -> bool {
-        let found = co401memory1::emcy::emergencies(co401memory1::Mode::Default).iter().find(|e| e.name == name).copied();
+        let found = co401memory1::emcy::by_name(co401memory1::Mode::Default, name);
         found.map(|e| self.node_mut().clear(&e)).is_some()
     }
     fn on_bus_state(&mut self, bus: BusState, now_us: u64) {
