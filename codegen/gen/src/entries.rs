@@ -207,6 +207,8 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             #(#tables)*
             /// Every entry of `mode`, sorted by index and sub-index; consecutive sub-entries that
             /// are described alike share one run (`sub..=last_sub`).
+            // Every engine looks entries up: one call each, not the `match` in every caller.
+            #[inline(never)]
             pub fn entries(mode: Mode) -> &'static [#stack::od::EntryInfo] {
                 #select
             }
