@@ -25,9 +25,9 @@ fn check(d: &Device, mode: Option<&str>, table: &[EntryInfo], rpdos: &[PdoDefaul
             assert_eq!(info.data_type, e.data_type, "{what}");
             assert_eq!(info.access, e.access, "{what}");
             assert_eq!(info.host_access, e.host_access, "{what}");
-            assert_eq!(info.host_write_before_can_enabled, e.host_write_when == WriteWhen::BeforeCanEnabled, "{what}");
-            assert_eq!(info.pdo_mappable, e.pdo_mapping, "{what}");
-            assert_eq!(info.storage, e.storage, "{what}");
+            assert_eq!(info.host_write_before_can_enabled(), e.host_write_when == WriteWhen::BeforeCanEnabled, "{what}");
+            assert_eq!(info.pdo_mappable(), e.pdo_mapping, "{what}");
+            assert_eq!(info.storage(), e.storage, "{what}");
             if let Some(bits) = e.data_type.bits() {
                 assert_eq!(u32::from(info.size), bits.div_ceil(8), "{what}");
             }

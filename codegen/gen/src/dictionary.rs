@@ -342,6 +342,10 @@ pub fn dictionary(d: &Device, options: &Options) -> TokenStream {
                 od::entries(self.mode)
             }
 
+            fn limits(&self) -> &'static [#stack::od::Limits] {
+                &od::LIMITS
+            }
+
             #[allow(unreachable_patterns)]
             fn field(&mut self, info: &#stack::od::EntryInfo, sub: u8) -> Option<&mut dyn #stack::value::OdValue> {
                 let field: &mut dyn #stack::value::OdValue = match (info.object, sub) {

@@ -5,7 +5,7 @@ use crate::modes::Modes;
 use coforge_spec::model::{Device, Entry, Object, Value, in_mode};
 use coforge_spec::types::{DataType, NmtState, WriteWhen};
 use proc_macro2::{Ident, Span, TokenStream};
-use quote::{format_ident, quote};
+use quote::quote;
 
 /// Value limits of an entry: (low, high, allowed values).
 type LimitsKey = (Option<i64>, Option<i64>, Vec<i64>);
@@ -136,17 +136,18 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
             quote!(#stack::od::NmtStates::NONE #(.with(#stack::od::NmtState::#states))*)
         }
     };
+    // 0: none; n: entry n - 1 of `od::LIMITS`.
     let limits = match &m.limits {
-        None => quote!(None),
+        None => 0,
         Some(key) => {
-            let n = limits.iter().position(|k| k == key).unwrap_or_else(|| {
+            let at = limits.iter().position(|k| k == key).unwrap_or_else(|| {
                 limits.push(key.clone());
                 limits.len() - 1
             });
-            let name = format_ident!("LIMITS_{}", n);
-            quote!(Some(&#name))
+            at + 1
         }
     };
+    let limits = crate::dec(limits as u64);
     quote! {
         #stack::od::EntryInfo {
             index: #index,
@@ -157,10 +158,7 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
             data_type: #stack::od::DataType::#data_type,
             access: #stack::od::Access::#access,
             host_access: #stack::od::HostAccess::#host_access,
-            host_write_before_can_enabled: #before,
-            pdo_mappable: #pdo,
-            storage: #stack::od::Storage::#storage,
-            writable_in: #writable_in,
+            flags: #stack::od::EntryFlags::new(#stack::od::Storage::#storage, #pdo, #before, #writable_in),
             size: #size,
             limits: #limits,
         }
@@ -179,19 +177,22 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
         })
         .collect();
     let (tables, select) = modes.tables("ENTRIES", &quote!(#stack::od::EntryInfo), &per_mode);
-    let limit_statics = limits.iter().enumerate().map(|(n, (low, high, values))| {
-        let name = format_ident!("LIMITS_{}", n);
-        let opt = |v: &Option<i64>| match v {
-            Some(v) => {
-                let v = proc_macro2::Literal::i64_unsuffixed(*v);
-                quote!(Some(#v))
-            }
-            None => quote!(None),
-        };
-        let values = values.iter().map(|v| proc_macro2::Literal::i64_unsuffixed(*v));
-        let (low, high) = (opt(low), opt(high));
-        quote! { static #name: #stack::od::Limits = #stack::od::Limits { low: #low, high: #high, values: &[#(#values),*] }; }
-    });
+    let limit_items: Vec<TokenStream> = limits
+        .iter()
+        .map(|(low, high, values)| {
+            let opt = |v: &Option<i64>| match v {
+                Some(v) => {
+                    let v = proc_macro2::Literal::i64_unsuffixed(*v);
+                    quote!(Some(#v))
+                }
+                None => quote!(None),
+            };
+            let values = values.iter().map(|v| proc_macro2::Literal::i64_unsuffixed(*v));
+            let (low, high) = (opt(low), opt(high));
+            quote!(#stack::od::Limits { low: #low, high: #high, values: &[#(#values),*] })
+        })
+        .collect();
+    let limit_count = crate::dec(limit_items.len() as u64);
     // The SDO server buffers a download until its last segment: size the buffer for the
     // largest value the bus may write. Domains without a declared length do not count; a
     // download larger than the buffer is refused with "out of memory".
@@ -203,7 +204,8 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             use super::Mode;
             /// Bytes of the largest value the bus may write (the SDO download buffer).
             pub const MAX_WRITE_SIZE: usize = #max_write;
-            #(#limit_statics)*
+            /// Every distinct value limit of the dictionary: an entry's `limits` n is entry n - 1.
+            pub static LIMITS: [#stack::od::Limits; #limit_count] = [#(#limit_items),*];
             #(#tables)*
             /// Every entry of `mode`, sorted by index and sub-index; consecutive sub-entries that
             /// are described alike share one run (`sub..=last_sub`).

@@ -5,7 +5,7 @@
 //! Generated per device:
 //! - `Mode`: the device's operating modes (`Mode::Default` for a device without modes);
 //! - `od::entries(mode)`: the sorted [`EntryInfo`] table, identical sub-entries merged into
-//!   runs, value limits in shared statics;
+//!   runs, value limits in one table (`od::LIMITS`) the runs index;
 //! - `pdo::rpdos(mode)` / `pdo::tpdos(mode)`: the default PDOs, with compile-time checks that
 //!   every mapping fits a CAN frame;
 //! - `Od<A>`: the typed dictionary and its `EntryAccess`/`NodeDictionary` dispatch;

@@ -13,14 +13,14 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         let ctx = self.ctx();
         let entry = self.od.entry(index, sub)?;
         if matches!(index, 0x1010 | 0x1011) && sub >= 1 {
-            entry.check_write(side, &ctx, data)?;
+            entry.check_write(side, &ctx, data, self.od.limits())?;
             return self.store_command(index, sub, data);
         }
         self.check_communication(index, sub, data, side)?;
         entry.check_write_access(side, &ctx)?;
         self.od.write_entry(entry, index, sub, data)?;
         self.after_write(index, sub);
-        if self.cfg.auto_save && entry.storage == Storage::Persistent && side != Side::Device {
+        if self.cfg.auto_save && entry.storage() == Storage::Persistent && side != Side::Device {
             self.store.save(&self.od, crate::od::Area::ALL).map_err(|_| SdoAbort::Hardware)?;
         }
         Ok(())

@@ -15,13 +15,15 @@ pub struct Limits {
 
 /// What the runtime knows about an entry, or about a run of identical entries (the 128 bytes
 /// of a memory block share one `EntryInfo` with `sub..=last_sub`), so that the generated
-/// table stays small in flash.
+/// table stays small in flash: 14 bytes a run (the flags and the limits are bytes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EntryInfo {
     pub index: u16,
     /// The number of the object in the generated dictionary, dense from 0 and the same in
     /// every mode: what its field dispatch switches on, so the switch is a jump table.
     pub object: u16,
+    /// Size in bytes; for strings and domains the maximum.
+    pub size: u16,
     /// First sub-index this description covers.
     pub sub: u8,
     /// Last sub-index this description covers (equal to `sub` for a single entry).
@@ -36,15 +38,37 @@ pub struct EntryInfo {
     pub access: Access,
     /// Serial-host access.
     pub host_access: HostAccess,
-    /// Host writes are accepted only until the CANopen interface is enabled.
-    pub host_write_before_can_enabled: bool,
-    pub pdo_mappable: bool,
-    pub storage: Storage,
-    /// NMT states in which a bus write is accepted.
-    pub writable_in: NmtStates,
-    /// Size in bytes; for strings and domains the maximum.
-    pub size: u16,
-    pub limits: Option<&'static Limits>,
+    /// Storage class, PDO mappability, the host-write rule and the NMT states of bus writes,
+    /// read through [`storage`](Self::storage), [`pdo_mappable`](Self::pdo_mappable),
+    /// [`host_write_before_can_enabled`](Self::host_write_before_can_enabled) and
+    /// [`writable_in`](Self::writable_in).
+    pub flags: EntryFlags,
+    /// Value limits: 0 for none, `n` for entry `n - 1` of the dictionary's limits table
+    /// ([`EntryAccess::limits`](super::EntryAccess::limits)), which the value checks receive.
+    pub limits: u8,
+}
+
+/// The one-byte properties of an entry: bits 0..=2 the NMT states of bus writes, bit 3
+/// PDO-mappable, bit 4 host writes only before the CAN interface is enabled, bits 5..=6 the
+/// storage class.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EntryFlags(u8);
+
+impl EntryFlags {
+    const PDO_MAPPABLE: u8 = 1 << 3;
+    const HOST_WRITE_BEFORE_CAN_ENABLED: u8 = 1 << 4;
+    const STORAGE_SHIFT: u8 = 5;
+
+    pub const fn new(storage: Storage, pdo_mappable: bool, host_write_before_can_enabled: bool, writable_in: NmtStates) -> EntryFlags {
+        let storage = match storage {
+            Storage::Ram => 0,
+            Storage::Persistent => 1,
+            Storage::App => 2,
+        };
+        let pdo = if pdo_mappable { Self::PDO_MAPPABLE } else { 0 };
+        let host = if host_write_before_can_enabled { Self::HOST_WRITE_BEFORE_CAN_ENABLED } else { 0 };
+        EntryFlags(writable_in.bits() | pdo | host | storage << Self::STORAGE_SHIFT)
+    }
 }
 
 /// How much of a value a read copied, and how long the value is.
@@ -55,6 +79,33 @@ pub struct ReadLen {
 }
 
 impl EntryInfo {
+    pub const fn storage(&self) -> Storage {
+        match self.flags.0 >> EntryFlags::STORAGE_SHIFT {
+            0 => Storage::Ram,
+            1 => Storage::Persistent,
+            _ => Storage::App,
+        }
+    }
+
+    pub const fn pdo_mappable(&self) -> bool {
+        self.flags.0 & EntryFlags::PDO_MAPPABLE != 0
+    }
+
+    /// Host writes are accepted only until the CANopen interface is enabled.
+    pub const fn host_write_before_can_enabled(&self) -> bool {
+        self.flags.0 & EntryFlags::HOST_WRITE_BEFORE_CAN_ENABLED != 0
+    }
+
+    /// NMT states in which a bus write is accepted.
+    pub const fn writable_in(&self) -> NmtStates {
+        NmtStates::from_bits(self.flags.0)
+    }
+
+    /// The entry's value limits in `table`, the dictionary's limits table.
+    pub fn limits_in(&self, table: &'static [Limits]) -> Option<&'static Limits> {
+        table.get(usize::from(self.limits).checked_sub(1)?)
+    }
+
     /// Whether `side` may read this entry, with the abort code if not.
     pub fn check_read(&self, side: Side) -> Result<(), SdoAbort> {
         match side {
@@ -67,20 +118,22 @@ impl EntryInfo {
         }
     }
 
-    /// Whether `side` may write `data` to this entry: access, state, length and value.
-    pub fn check_write(&self, side: Side, ctx: &AccessContext, data: &[u8]) -> Result<(), SdoAbort> {
+    /// Whether `side` may write `data` to this entry: access, state, length and value
+    /// (`limits`: the dictionary's limits table).
+    pub fn check_write(&self, side: Side, ctx: &AccessContext, data: &[u8], limits: &'static [Limits]) -> Result<(), SdoAbort> {
         self.check_write_access(side, ctx)?;
-        self.check_data(data)
+        self.check_data(data, limits)
     }
 
-    /// Whether `data` fits this entry: length and value, whoever writes it.
-    pub fn check_data(&self, data: &[u8]) -> Result<(), SdoAbort> {
+    /// Whether `data` fits this entry: length and value, whoever writes it (`limits`: the
+    /// dictionary's limits table).
+    pub fn check_data(&self, data: &[u8], limits: &'static [Limits]) -> Result<(), SdoAbort> {
         // The common case first: full length, no limits, not a BOOLEAN.
-        if data.len() == usize::from(self.size) && self.limits.is_none() && self.data_type != DataType::Boolean {
+        if data.len() == usize::from(self.size) && self.limits == 0 && self.data_type != DataType::Boolean {
             return Ok(());
         }
         self.check_length(data.len())?;
-        self.check_value(data)
+        self.check_value(data, self.limits_in(limits))
     }
 
     /// Whether `side` may write this entry now, whatever the value: access and state.
@@ -94,7 +147,7 @@ impl EntryInfo {
                 if !self.access.writable() {
                     return Err(SdoAbort::ReadOnly);
                 }
-                if !self.writable_in.contains(ctx.nmt) {
+                if !self.writable_in().contains(ctx.nmt) {
                     return Err(SdoAbort::DataTransferState);
                 }
             }
@@ -102,7 +155,7 @@ impl EntryInfo {
                 if !self.host_access.writable() {
                     return Err(if self.host_access == HostAccess::None { SdoAbort::UnsupportedAccess } else { SdoAbort::ReadOnly });
                 }
-                if self.host_write_before_can_enabled && ctx.can_enabled {
+                if self.host_write_before_can_enabled() && ctx.can_enabled {
                     return Err(SdoAbort::DataTransferState);
                 }
             }
@@ -132,21 +185,20 @@ impl EntryInfo {
         }
     }
 
-    fn check_value(&self, data: &[u8]) -> Result<(), SdoAbort> {
+    fn check_value(&self, data: &[u8], limits: Option<&Limits>) -> Result<(), SdoAbort> {
         // Fast path for the common entry without limits: a value of the right length always
         // fits its integer type, except a BOOLEAN byte holding 2..255.
-        if self.limits.is_none() {
+        let Some(limits) = limits else {
             return match (self.data_type, data) {
                 (DataType::Boolean, [b]) if *b > 1 => Err(SdoAbort::ValueTooHigh),
                 _ => Ok(()),
             };
-        }
+        };
         let Some(value) = decode_int(self.data_type, data) else { return Ok(()) };
         // Only BOOLEAN can carry bits its type does not allow (a byte holding 2..255).
         if self.data_type.int_range().is_some_and(|(_, hi)| value > hi) {
             return Err(SdoAbort::ValueTooHigh);
         }
-        let Some(limits) = self.limits else { return Ok(()) };
         if !limits.values.is_empty() && !limits.values.iter().any(|&v| i128::from(v) == value) {
             return Err(SdoAbort::InvalidValue);
         }
@@ -189,12 +241,9 @@ pub(crate) const fn test_entry(data_type: DataType, access: Access, host_access:
         data_type,
         access,
         host_access,
-        host_write_before_can_enabled: false,
-        pdo_mappable: false,
-        storage: Storage::Ram,
-        writable_in: NmtStates::ALL,
+        flags: EntryFlags::new(Storage::Ram, false, false, NmtStates::ALL),
         size,
-        limits: None,
+        limits: 0,
     }
 }
 
@@ -203,8 +252,34 @@ mod tests {
     use super::*;
     use coforge_types::NmtState;
 
-    const fn info(data_type: DataType, access: Access, host_access: HostAccess, size: u16) -> EntryInfo {
-        test_entry(data_type, access, host_access, size)
+    /// The limits table of these tests' entries: `limits: n` is entry `n - 1`.
+    static LIMITS: [Limits; 3] = [
+        Limits { low: Some(1), high: Some(127), values: &[] },
+        Limits { low: None, high: None, values: &[1, 2, 3, 0x10] },
+        Limits { low: Some(-100), high: Some(100), values: &[] },
+    ];
+    const NODE_ID: u8 = 1;
+    const MODES: u8 = 2;
+    const SIGNED: u8 = 3;
+
+    /// An entry under test, checked against [`LIMITS`] as a dictionary checks against its own.
+    struct Entry(EntryInfo);
+
+    impl core::ops::Deref for Entry {
+        type Target = EntryInfo;
+        fn deref(&self) -> &EntryInfo {
+            &self.0
+        }
+    }
+
+    impl Entry {
+        fn check_write(&self, side: Side, ctx: &AccessContext, data: &[u8]) -> Result<(), SdoAbort> {
+            self.0.check_write(side, ctx, data, &LIMITS)
+        }
+    }
+
+    const fn info(data_type: DataType, access: Access, host_access: HostAccess, size: u16) -> Entry {
+        Entry(test_entry(data_type, access, host_access, size))
     }
 
     const OP: AccessContext = AccessContext { nmt: NmtState::Operational, can_enabled: true };
@@ -223,7 +298,10 @@ mod tests {
         assert_eq!(m.check_read(Side::Host), Ok(()));
         assert_eq!(m.check_write(Side::Host, &OP, &[1]), Err(SdoAbort::ReadOnly));
         // Not reachable from CAN at all (CO401GW1 100B).
-        let n = EntryInfo { host_write_before_can_enabled: true, ..info(DataType::Unsigned8, Access::None, HostAccess::Rw, 1) };
+        let n = Entry(EntryInfo {
+            flags: EntryFlags::new(Storage::Ram, false, true, NmtStates::ALL),
+            ..info(DataType::Unsigned8, Access::None, HostAccess::Rw, 1).0
+        });
         assert_eq!(n.check_read(Side::Bus), Err(SdoAbort::NoObject));
         assert_eq!(n.check_write(Side::Bus, &PREOP, &[5]), Err(SdoAbort::NoObject));
         assert_eq!(n.check_write(Side::Host, &PREOP, &[5]), Ok(()));
@@ -234,22 +312,24 @@ mod tests {
 
     #[test]
     fn writes_restricted_to_nmt_states() {
-        let e = EntryInfo { writable_in: NmtStates::NONE.with(NmtState::PreOperational), ..info(DataType::Unsigned32, Access::Rw, HostAccess::None, 4) };
+        let writable_in = NmtStates::NONE.with(NmtState::PreOperational);
+        let e = Entry(EntryInfo {
+            flags: EntryFlags::new(Storage::Ram, false, false, writable_in),
+            ..info(DataType::Unsigned32, Access::Rw, HostAccess::None, 4).0
+        });
         assert_eq!(e.check_write(Side::Bus, &PREOP, &[0; 4]), Ok(()));
         assert_eq!(e.check_write(Side::Bus, &OP, &[0; 4]), Err(SdoAbort::DataTransferState));
     }
 
     #[test]
     fn lengths_and_values_are_checked() {
-        static NODE_ID: Limits = Limits { low: Some(1), high: Some(127), values: &[] };
-        let e = EntryInfo { limits: Some(&NODE_ID), ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
+        let e = Entry(EntryInfo { limits: NODE_ID, ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1).0 });
         assert_eq!(e.check_write(Side::Bus, &OP, &[]), Err(SdoAbort::LengthTooLow));
         assert_eq!(e.check_write(Side::Bus, &OP, &[1, 2]), Err(SdoAbort::LengthTooHigh));
         assert_eq!(e.check_write(Side::Bus, &OP, &[0]), Err(SdoAbort::ValueTooLow));
         assert_eq!(e.check_write(Side::Bus, &OP, &[128]), Err(SdoAbort::ValueTooHigh));
         assert_eq!(e.check_write(Side::Device, &OP, &[128]), Err(SdoAbort::ValueTooHigh), "limits bind the device too");
-        static MODES: Limits = Limits { low: None, high: None, values: &[1, 2, 3, 0x10] };
-        let v = EntryInfo { limits: Some(&MODES), ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1) };
+        let v = Entry(EntryInfo { limits: MODES, ..info(DataType::Unsigned8, Access::Rw, HostAccess::None, 1).0 });
         assert_eq!(v.check_write(Side::Bus, &OP, &[0x10]), Ok(()));
         assert_eq!(v.check_write(Side::Bus, &OP, &[4]), Err(SdoAbort::InvalidValue));
         let b = info(DataType::Boolean, Access::Rw, HostAccess::None, 1);
@@ -258,8 +338,7 @@ mod tests {
         let s = info(DataType::VisibleString, Access::Rw, HostAccess::None, 8);
         assert_eq!(s.check_write(Side::Bus, &OP, b"Datei1"), Ok(()), "strings may be shorter than their maximum");
         assert_eq!(s.check_write(Side::Bus, &OP, b"123456789"), Err(SdoAbort::LengthTooHigh));
-        static SIGNED: Limits = Limits { low: Some(-100), high: Some(100), values: &[] };
-        let i = EntryInfo { limits: Some(&SIGNED), ..info(DataType::Integer16, Access::Rw, HostAccess::None, 2) };
+        let i = Entry(EntryInfo { limits: SIGNED, ..info(DataType::Integer16, Access::Rw, HostAccess::None, 2).0 });
         assert_eq!(i.check_write(Side::Bus, &OP, &(-100_i16).to_le_bytes()), Ok(()));
         assert_eq!(i.check_write(Side::Bus, &OP, &(-101_i16).to_le_bytes()), Err(SdoAbort::ValueTooLow));
     }
@@ -277,9 +356,9 @@ mod tests {
 
     #[test]
     fn entry_info_is_small_enough_for_flash_tables() {
-        // Most of a dictionary's flash is this table: 16 bytes and the limits pointer per run
-        // (20 bytes on Cortex-M).
-        let most = 16 + core::mem::size_of::<Option<&Limits>>();
+        // Most of a dictionary's flash is this table: at most 16 bytes per run on any target
+        // (flags and limits are bytes; the limits are an index into the dictionary's table).
+        let most = 16;
         assert!(core::mem::size_of::<EntryInfo>() <= most, "{}", core::mem::size_of::<EntryInfo>());
     }
 }

@@ -88,7 +88,7 @@ pub fn check_entry(od: &impl EntryAccess, word: u32, dir: Dir) -> Result<Mapped,
         Dir::Rx => e.access.writable(),
         Dir::Tx => e.access.readable(),
     };
-    if !e.pdo_mappable || !allowed {
+    if !e.pdo_mappable() || !allowed {
         return Err(SdoAbort::NotMappable);
     }
     let variable = matches!(e.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
