@@ -1,6 +1,7 @@
 //! How typed dictionary fields are read and written as little-endian bytes.
 
-use crate::od::{EntryInfo, ReadLen, SdoAbort, decode_int, read_slice};
+use crate::od::entry::Int;
+use crate::od::{EntryInfo, ReadLen, SdoAbort, read_slice};
 
 /// A value stored in a dictionary field. `write` gets data that already passed the access,
 /// length and range checks of [`EntryInfo::check_write`].
@@ -23,8 +24,10 @@ macro_rules! integer_value {
                     *self = <$t>::from_le_bytes(bytes);
                     return Ok(());
                 }
-                let value = decode_int(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)?;
-                *self = <$t>::try_from(value).map_err(|_| SdoAbort::ValueTooHigh)?;
+                *self = match Int::decode(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)? {
+                    Int::Signed(v) => <$t>::try_from(v).map_err(|_| SdoAbort::ValueTooHigh)?,
+                    Int::Unsigned(v) => <$t>::try_from(v).map_err(|_| SdoAbort::ValueTooHigh)?,
+                };
                 Ok(())
             }
         }
@@ -38,7 +41,7 @@ impl OdValue for bool {
         read_slice(&[u8::from(*self)], offset, buf)
     }
     fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
-        *self = decode_int(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)? != 0;
+        *self = !Int::decode(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)?.is(0);
         Ok(())
     }
 }

@@ -194,39 +194,87 @@ impl EntryInfo {
                 _ => Ok(()),
             };
         };
-        let Some(value) = decode_int(self.data_type, data) else { return Ok(()) };
-        // Only BOOLEAN can carry bits its type does not allow (a byte holding 2..255).
-        if self.data_type.int_range().is_some_and(|(_, hi)| value > hi) {
+        let Some(value) = Int::decode(self.data_type, data) else { return Ok(()) };
+        // Only BOOLEAN can carry bits its type does not allow (a byte holding 2..255): a value
+        // of any other integer type fits it once its length is right.
+        if self.data_type == DataType::Boolean && value.above(1) {
             return Err(SdoAbort::ValueTooHigh);
         }
-        if !limits.values.is_empty() && !limits.values.iter().any(|&v| i128::from(v) == value) {
+        if !limits.values.is_empty() && !limits.values.iter().any(|&v| value.is(v)) {
             return Err(SdoAbort::InvalidValue);
         }
-        if limits.low.is_some_and(|low| value < i128::from(low)) {
+        if limits.low.is_some_and(|low| value.below(low)) {
             return Err(SdoAbort::ValueTooLow);
         }
-        if limits.high.is_some_and(|high| value > i128::from(high)) {
+        if limits.high.is_some_and(|high| value.above(high)) {
             return Err(SdoAbort::ValueTooHigh);
         }
         Ok(())
     }
 }
 
+/// The value of a little-endian integer entry, as its type's signedness says: compared with
+/// the `i64` limits without 128-bit arithmetic, which is costly on a Cortex-M0.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Int {
+    Signed(i64),
+    /// Unsigned types and BOOLEAN (0/1).
+    Unsigned(u64),
+}
+
+impl Int {
+    /// The value of `data` as `data_type`; `None` for other types or a length that does not
+    /// match the type.
+    pub(crate) fn decode(data_type: DataType, data: &[u8]) -> Option<Int> {
+        use DataType::*;
+        let signed = match data_type {
+            Integer8 | Integer16 | Integer24 | Integer32 | Integer40 | Integer48 | Integer56 | Integer64 => true,
+            Boolean | Unsigned8 | Unsigned16 | Unsigned24 | Unsigned32 | Unsigned40 | Unsigned48 | Unsigned56 | Unsigned64 => false,
+            _ => return None,
+        };
+        let bits = data_type.bits()?;
+        let bytes = usize::try_from(bits.div_ceil(8)).ok()?;
+        if data.len() != bytes {
+            return None;
+        }
+        let raw = data.iter().rev().fold(0_u64, |acc, &b| acc << 8 | u64::from(b));
+        // Signed types: sign-extend from the type's width by shifting its sign bit to bit 63.
+        let unused = 64 - bits;
+        Some(if signed { Int::Signed(((raw << unused) as i64) >> unused) } else { Int::Unsigned(raw) })
+    }
+
+    /// Whether the value is `v`.
+    pub(crate) fn is(self, v: i64) -> bool {
+        match self {
+            Int::Signed(x) => x == v,
+            Int::Unsigned(x) => u64::try_from(v).is_ok_and(|v| x == v),
+        }
+    }
+
+    /// Whether the value is below `low`.
+    fn below(self, low: i64) -> bool {
+        match self {
+            Int::Signed(x) => x < low,
+            Int::Unsigned(x) => u64::try_from(low).is_ok_and(|low| x < low),
+        }
+    }
+
+    /// Whether the value is above `high`.
+    fn above(self, high: i64) -> bool {
+        match self {
+            Int::Signed(x) => x > high,
+            Int::Unsigned(x) => u64::try_from(high).map_or(true, |high| x > high),
+        }
+    }
+}
+
 /// The value of a little-endian integer entry (BOOLEAN counts as 0/1); `None` for other types
 /// or a length that does not match the type.
 pub fn decode_int(data_type: DataType, data: &[u8]) -> Option<i128> {
-    let (lo, _) = data_type.int_range()?;
-    let bits = data_type.bits()?;
-    let bytes = usize::try_from(bits.div_ceil(8)).ok()?;
-    if data.len() != bytes {
-        return None;
-    }
-    // At most 64 bits: assembled in a u64, widened once (128-bit shifts are costly on a
-    // Cortex-M0).
-    let raw = data.iter().rev().fold(0_u64, |acc, &b| acc << 8 | u64::from(b));
-    // Signed types: sign-extend from the type's width by shifting its sign bit to bit 63.
-    let unused = 64 - bits;
-    if lo < 0 { Some(i128::from(((raw << unused) as i64) >> unused)) } else { Some(i128::from(raw)) }
+    Int::decode(data_type, data).map(|v| match v {
+        Int::Signed(v) => i128::from(v),
+        Int::Unsigned(v) => i128::from(v),
+    })
 }
 
 /// An entry at 2000h.0 with no limits, for unit tests.
@@ -352,6 +400,37 @@ mod tests {
         assert_eq!(decode_int(DataType::Integer64, &[0xFF; 8]), Some(-1));
         assert_eq!(decode_int(DataType::Unsigned32, &[1, 2]), None);
         assert_eq!(decode_int(DataType::VisibleString, b"x"), None);
+    }
+
+    #[test]
+    fn comparisons_without_128_bits_agree_with_the_exact_ones() {
+        let limits = [i64::MIN, i64::MIN + 1, -0x8000_0001, -129, -128, -1, 0, 1, 2, 127, 128, 255, 0xFFFF_FFFF, i64::MAX - 1, i64::MAX];
+        let mut x = 7_u64;
+        for t in DataType::ALL {
+            let Some(bits) = t.bits() else { continue };
+            let len = bits.div_ceil(8) as usize;
+            for n in 0..2000 {
+                // Edge patterns first (all zero, all ones, sign bit only), then a fixed LCG.
+                x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                let raw = match n {
+                    0 => 0,
+                    1 => u64::MAX,
+                    2 => 1 << (len * 8 - 1),
+                    3 => (1 << (len * 8 - 1)) - 1,
+                    _ => x,
+                };
+                let data = &raw.to_le_bytes()[..len];
+                let (Some(value), Some(exact)) = (Int::decode(t, data), decode_int(t, data)) else {
+                    assert_eq!(Int::decode(t, data).is_some(), decode_int(t, data).is_some(), "{t}");
+                    continue;
+                };
+                for l in limits {
+                    assert_eq!(value.is(l), exact == i128::from(l), "{t} {exact} == {l}");
+                    assert_eq!(value.below(l), exact < i128::from(l), "{t} {exact} < {l}");
+                    assert_eq!(value.above(l), exact > i128::from(l), "{t} {exact} > {l}");
+                }
+            }
+        }
     }
 
     #[test]
