@@ -22,9 +22,9 @@ fn check(d: &Device, mode: Option<&str>, table: &[EntryInfo], rpdos: &[PdoDefaul
         for e in o.entries.iter().filter(|e| in_mode(&e.modes, mode)) {
             let info = find(table, o.index, e.sub).unwrap_or_else(|a| panic!("{ctx}: {:04X}.{} missing ({a:?})", o.index, e.sub));
             let what = format!("{ctx}: {:04X}.{}", o.index, e.sub);
-            assert_eq!(info.data_type, e.data_type, "{what}");
-            assert_eq!(info.access, e.access, "{what}");
-            assert_eq!(info.host_access, e.host_access, "{what}");
+            assert_eq!(info.data_type(), e.data_type, "{what}");
+            assert_eq!(info.access(), e.access, "{what}");
+            assert_eq!(info.host_access(), e.host_access, "{what}");
             assert_eq!(info.host_write_before_can_enabled(), e.host_write_when == WriteWhen::BeforeCanEnabled, "{what}");
             assert_eq!(info.pdo_mappable(), e.pdo_mapping, "{what}");
             assert_eq!(info.storage(), e.storage, "{what}");
@@ -34,8 +34,8 @@ fn check(d: &Device, mode: Option<&str>, table: &[EntryInfo], rpdos: &[PdoDefaul
             covered += 1;
         }
     }
-    assert!(table.iter().all(|r| r.copies <= coforge_stack::pdo::mapping::MAX_COPIES), "{ctx}: copies fit the PDO mapping cache");
-    let in_table: usize = table.iter().map(|r| (usize::from(r.last_sub - r.sub) + 1) * (usize::from(r.copies) + 1)).sum();
+    assert!(table.iter().all(|r| r.copies() <= coforge_stack::pdo::mapping::MAX_COPIES), "{ctx}: copies fit the PDO mapping cache");
+    let in_table: usize = table.iter().map(|r| (usize::from(r.last_sub - r.sub) + 1) * (usize::from(r.copies()) + 1)).sum();
     assert_eq!(in_table, covered, "{ctx}: the table holds exactly the spec's entries");
     for (dir, generated) in [(PdoDir::Rx, rpdos), (PdoDir::Tx, tpdos)] {
         let want: Vec<_> = d.pdo.pdos.iter().filter(|p| p.dir == dir && in_mode(&p.modes, mode)).collect();

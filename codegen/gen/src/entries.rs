@@ -128,14 +128,22 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
     let access = ident(&m.access);
     let host_access = ident(&m.host_access);
     let storage = ident(&m.storage);
-    let (before, pdo, size) = (m.host_write_before_can_enabled, m.pdo_mappable, crate::dec(m.size.into()));
-    let writable_in = match &m.writable_in {
-        None => quote!(#stack::od::NmtStates::ALL),
-        Some(states) => {
-            let states = states.iter().map(|s| ident(&format!("{s:?}")));
-            quote!(#stack::od::NmtStates::NONE #(.with(#stack::od::NmtState::#states))*)
-        }
-    };
+    let (before, pdo, size) = (&m.host_write_before_can_enabled, &m.pdo_mappable, crate::dec(m.size.into()));
+    // The flags spell out only what differs from `EntryFlags::new`.
+    let mut flags = quote!(#stack::od::EntryFlags::new(#stack::od::HostAccess::#host_access, #stack::od::Storage::#storage));
+    if *pdo {
+        flags = quote!(#flags.pdo_mappable());
+    }
+    if *before {
+        flags = quote!(#flags.host_write_before_can_enabled());
+    }
+    if let Some(states) = &m.writable_in {
+        let states = states.iter().map(|s| ident(&format!("{s:?}")));
+        flags = quote!(#flags.writable_in(#stack::od::NmtStates::NONE #(.with(#stack::od::NmtState::#states))*));
+    }
+    if r.copies != 0 {
+        flags = quote!(#flags.copies(#copies));
+    }
     // 0: none; n: entry n - 1 of `od::LIMITS`.
     let limits = match &m.limits {
         None => 0,
@@ -152,15 +160,12 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
         #stack::od::EntryInfo {
             index: #index,
             object: #object,
+            size: #size,
             sub: #sub,
             last_sub: #last_sub,
-            copies: #copies,
-            data_type: #stack::od::DataType::#data_type,
-            access: #stack::od::Access::#access,
-            host_access: #stack::od::HostAccess::#host_access,
-            flags: #stack::od::EntryFlags::new(#stack::od::Storage::#storage, #pdo, #before, #writable_in),
-            size: #size,
             limits: #limits,
+            kind: #stack::od::EntryKind::new(#stack::od::DataType::#data_type, #stack::od::Access::#access),
+            flags: #flags,
         }
     }
 }

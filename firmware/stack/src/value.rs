@@ -22,7 +22,7 @@ fn int_bits(entry: &EntryInfo, data: &[u8], width: usize, signed: bool) -> Resul
     // The field's range: 0..=2^bits - 1, or -2^(bits - 1)..=2^(bits - 1) - 1.
     let unused = 64_u32.saturating_sub(8 * width as u32);
     let (min, max) = if signed { (i64::MIN >> unused, u64::MAX >> (unused + 1)) } else { (0, u64::MAX >> unused) };
-    match Int::decode(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)? {
+    match Int::decode(entry.data_type(), data).ok_or(SdoAbort::LengthMismatch)? {
         Int::Signed(v) if v >= min && u64::try_from(v).map_or(true, |v| v <= max) => Ok(v as u64),
         Int::Unsigned(v) if v <= max => Ok(v),
         _ => Err(SdoAbort::ValueTooHigh),
@@ -53,7 +53,7 @@ impl OdValue for bool {
         read_slice(&[u8::from(*self)], offset, buf)
     }
     fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
-        *self = !Int::decode(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)?.is(0);
+        *self = !Int::decode(entry.data_type(), data).ok_or(SdoAbort::LengthMismatch)?.is(0);
         Ok(())
     }
 }

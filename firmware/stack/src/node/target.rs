@@ -119,7 +119,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, 
 
     fn fixed_size(&mut self, index: u16, sub: u8) -> Option<usize> {
         let e = self.od.entry(index, sub).ok()?;
-        e.data_type.bits().map(|_| usize::from(e.size))
+        e.data_type().bits().map(|_| usize::from(e.size))
     }
 }
 

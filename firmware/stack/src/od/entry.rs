@@ -15,7 +15,8 @@ pub struct Limits {
 
 /// What the runtime knows about an entry, or about a run of identical entries (the 128 bytes
 /// of a memory block share one `EntryInfo` with `sub..=last_sub`), so that the generated
-/// table stays small in flash: 14 bytes a run (the flags and the limits are bytes).
+/// table stays small in flash: 12 bytes a run, the small properties packed into three bytes
+/// and read through accessors.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EntryInfo {
     pub index: u16,
@@ -28,46 +29,79 @@ pub struct EntryInfo {
     pub sub: u8,
     /// Last sub-index this description covers (equal to `sub` for a single entry).
     pub last_sub: u8,
-    /// How many further objects, `index + 1 ..= index + copies`, this run also describes:
-    /// objects that repeat alike (CO401Memory1's 64 memory blocks) share their runs. Only
-    /// app-backed objects repeat, so the field dispatch never sees a copy. At most
-    /// [`MAX_COPIES`](crate::pdo::mapping::MAX_COPIES).
-    pub copies: u8,
-    pub data_type: DataType,
-    /// CAN-side access.
-    pub access: Access,
-    /// Serial-host access.
-    pub host_access: HostAccess,
-    /// Storage class, PDO mappability, the host-write rule and the NMT states of bus writes,
-    /// read through [`storage`](Self::storage), [`pdo_mappable`](Self::pdo_mappable),
-    /// [`host_write_before_can_enabled`](Self::host_write_before_can_enabled) and
-    /// [`writable_in`](Self::writable_in).
-    pub flags: EntryFlags,
     /// Value limits: 0 for none, `n` for entry `n - 1` of the dictionary's limits table
     /// ([`EntryAccess::limits`](super::EntryAccess::limits)), which the value checks receive.
     pub limits: u8,
+    /// The data type and the CAN-side access: [`data_type`](Self::data_type),
+    /// [`access`](Self::access).
+    pub kind: EntryKind,
+    /// Everything else: [`host_access`](Self::host_access), [`storage`](Self::storage),
+    /// [`pdo_mappable`](Self::pdo_mappable),
+    /// [`host_write_before_can_enabled`](Self::host_write_before_can_enabled),
+    /// [`writable_in`](Self::writable_in) and [`copies`](Self::copies).
+    pub flags: EntryFlags,
 }
 
-/// The one-byte properties of an entry: bits 0..=2 the NMT states of bus writes, bit 3
-/// PDO-mappable, bit 4 host writes only before the CAN interface is enabled, bits 5..=6 the
-/// storage class.
+/// An entry's data type (bits 0..=4) and CAN-side access (bits 5..=7), each as its enum's
+/// discriminant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct EntryFlags(u8);
+pub struct EntryKind(u8);
+
+impl EntryKind {
+    pub const fn new(data_type: DataType, access: Access) -> EntryKind {
+        EntryKind(data_type as u8 | (access as u8) << 5)
+    }
+}
+
+/// The other properties of an entry, two bytes: bits 0..=2 the NMT states of bus writes, bit 3
+/// PDO-mappable, bit 4 host writes only before the CAN interface is enabled, bits 5..=6 the
+/// storage class, bits 7..=8 the host access, bits 9..=13 the copies. Built with [`new`]
+/// and the `const` setters, which generated tables spell out.
+///
+/// [`new`]: EntryFlags::new
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EntryFlags(u16);
 
 impl EntryFlags {
-    const PDO_MAPPABLE: u8 = 1 << 3;
-    const HOST_WRITE_BEFORE_CAN_ENABLED: u8 = 1 << 4;
-    const STORAGE_SHIFT: u8 = 5;
+    const PDO_MAPPABLE: u16 = 1 << 3;
+    const HOST_WRITE_BEFORE_CAN_ENABLED: u16 = 1 << 4;
+    const STORAGE_SHIFT: u16 = 5;
+    const HOST_SHIFT: u16 = 7;
+    const COPIES_SHIFT: u16 = 9;
 
-    pub const fn new(storage: Storage, pdo_mappable: bool, host_write_before_can_enabled: bool, writable_in: NmtStates) -> EntryFlags {
+    /// Host access and storage; writable by the bus in every NMT state, not PDO-mappable, no
+    /// host-write rule, no copies.
+    pub const fn new(host_access: HostAccess, storage: Storage) -> EntryFlags {
         let storage = match storage {
             Storage::Ram => 0,
             Storage::Persistent => 1,
             Storage::App => 2,
         };
-        let pdo = if pdo_mappable { Self::PDO_MAPPABLE } else { 0 };
-        let host = if host_write_before_can_enabled { Self::HOST_WRITE_BEFORE_CAN_ENABLED } else { 0 };
-        EntryFlags(writable_in.bits() | pdo | host | storage << Self::STORAGE_SHIFT)
+        let host = match host_access {
+            HostAccess::None => 0,
+            HostAccess::Ro => 1,
+            HostAccess::Wo => 2,
+            HostAccess::Rw => 3,
+        };
+        EntryFlags(NmtStates::ALL.bits() as u16 | storage << Self::STORAGE_SHIFT | host << Self::HOST_SHIFT)
+    }
+
+    pub const fn pdo_mappable(self) -> EntryFlags {
+        EntryFlags(self.0 | Self::PDO_MAPPABLE)
+    }
+
+    pub const fn host_write_before_can_enabled(self) -> EntryFlags {
+        EntryFlags(self.0 | Self::HOST_WRITE_BEFORE_CAN_ENABLED)
+    }
+
+    /// Bus writes only in `states`.
+    pub const fn writable_in(self, states: NmtStates) -> EntryFlags {
+        EntryFlags(self.0 & !(NmtStates::ALL.bits() as u16) | states.bits() as u16)
+    }
+
+    /// The run also describes the `copies` objects after its own (at most 31).
+    pub const fn copies(self, copies: u8) -> EntryFlags {
+        EntryFlags(self.0 & !(0x1F << Self::COPIES_SHIFT) | ((copies & 0x1F) as u16) << Self::COPIES_SHIFT)
     }
 }
 
@@ -79,8 +113,63 @@ pub struct ReadLen {
 }
 
 impl EntryInfo {
+    pub const fn data_type(&self) -> DataType {
+        use DataType::*;
+        // The enum's own order, so the compiler reduces this to the byte itself.
+        match self.kind.0 & 0x1F {
+            0 => Boolean,
+            1 => Integer8,
+            2 => Integer16,
+            3 => Integer24,
+            4 => Integer32,
+            5 => Integer40,
+            6 => Integer48,
+            7 => Integer56,
+            8 => Integer64,
+            9 => Unsigned8,
+            10 => Unsigned16,
+            11 => Unsigned24,
+            12 => Unsigned32,
+            13 => Unsigned40,
+            14 => Unsigned48,
+            15 => Unsigned56,
+            16 => Unsigned64,
+            17 => Real32,
+            18 => Real64,
+            19 => VisibleString,
+            20 => OctetString,
+            21 => UnicodeString,
+            22 => TimeOfDay,
+            23 => TimeDifference,
+            _ => Domain,
+        }
+    }
+
+    /// CAN-side access.
+    pub const fn access(&self) -> Access {
+        match self.kind.0 >> 5 {
+            0 => Access::Ro,
+            1 => Access::Wo,
+            2 => Access::Rw,
+            3 => Access::Rwr,
+            4 => Access::Rww,
+            5 => Access::Const,
+            _ => Access::None,
+        }
+    }
+
+    /// Serial-host access.
+    pub const fn host_access(&self) -> HostAccess {
+        match (self.flags.0 >> EntryFlags::HOST_SHIFT) & 3 {
+            0 => HostAccess::None,
+            1 => HostAccess::Ro,
+            2 => HostAccess::Wo,
+            _ => HostAccess::Rw,
+        }
+    }
+
     pub const fn storage(&self) -> Storage {
-        match self.flags.0 >> EntryFlags::STORAGE_SHIFT {
+        match (self.flags.0 >> EntryFlags::STORAGE_SHIFT) & 3 {
             0 => Storage::Ram,
             1 => Storage::Persistent,
             _ => Storage::App,
@@ -98,7 +187,15 @@ impl EntryInfo {
 
     /// NMT states in which a bus write is accepted.
     pub const fn writable_in(&self) -> NmtStates {
-        NmtStates::from_bits(self.flags.0)
+        NmtStates::from_bits(self.flags.0 as u8)
+    }
+
+    /// How many further objects, `index + 1 ..= index + copies`, this run also describes:
+    /// objects that repeat alike (CO401Memory1's 64 memory blocks) share their runs. Only
+    /// app-backed objects repeat, so the field dispatch never sees a copy. At most
+    /// [`MAX_COPIES`](crate::pdo::mapping::MAX_COPIES).
+    pub const fn copies(&self) -> u8 {
+        (self.flags.0 >> EntryFlags::COPIES_SHIFT) as u8 & 0x1F
     }
 
     /// The entry's value limits in `table`, the dictionary's limits table.
@@ -110,10 +207,10 @@ impl EntryInfo {
     pub fn check_read(&self, side: Side) -> Result<(), SdoAbort> {
         match side {
             Side::Device => Ok(()),
-            Side::Bus if self.access == Access::None => Err(SdoAbort::NoObject),
-            Side::Bus if !self.access.readable() => Err(SdoAbort::WriteOnly),
-            Side::Host if self.host_access == HostAccess::None => Err(SdoAbort::UnsupportedAccess),
-            Side::Host if !self.host_access.readable() => Err(SdoAbort::WriteOnly),
+            Side::Bus if self.access() == Access::None => Err(SdoAbort::NoObject),
+            Side::Bus if !self.access().readable() => Err(SdoAbort::WriteOnly),
+            Side::Host if self.host_access() == HostAccess::None => Err(SdoAbort::UnsupportedAccess),
+            Side::Host if !self.host_access().readable() => Err(SdoAbort::WriteOnly),
             Side::Bus | Side::Host => Ok(()),
         }
     }
@@ -129,7 +226,7 @@ impl EntryInfo {
     /// dictionary's limits table).
     pub fn check_data(&self, data: &[u8], limits: &'static [Limits]) -> Result<(), SdoAbort> {
         // The common case first: full length, no limits, not a BOOLEAN.
-        if data.len() == usize::from(self.size) && self.limits == 0 && self.data_type != DataType::Boolean {
+        if data.len() == usize::from(self.size) && self.limits == 0 && self.data_type() != DataType::Boolean {
             return Ok(());
         }
         self.check_length(data.len())?;
@@ -141,10 +238,10 @@ impl EntryInfo {
         match side {
             Side::Device => {}
             Side::Bus => {
-                if self.access == Access::None {
+                if self.access() == Access::None {
                     return Err(SdoAbort::NoObject);
                 }
-                if !self.access.writable() {
+                if !self.access().writable() {
                     return Err(SdoAbort::ReadOnly);
                 }
                 if !self.writable_in().contains(ctx.nmt) {
@@ -152,8 +249,8 @@ impl EntryInfo {
                 }
             }
             Side::Host => {
-                if !self.host_access.writable() {
-                    return Err(if self.host_access == HostAccess::None { SdoAbort::UnsupportedAccess } else { SdoAbort::ReadOnly });
+                if !self.host_access().writable() {
+                    return Err(if self.host_access() == HostAccess::None { SdoAbort::UnsupportedAccess } else { SdoAbort::ReadOnly });
                 }
                 if self.host_write_before_can_enabled() && ctx.can_enabled {
                     return Err(SdoAbort::DataTransferState);
@@ -170,12 +267,12 @@ impl EntryInfo {
 
     /// Whether this run describes object `index` (its own, or one of its copies).
     pub fn covers_index(&self, index: u16) -> bool {
-        index >= self.index && index - self.index <= u16::from(self.copies)
+        index >= self.index && index - self.index <= u16::from(self.copies())
     }
 
     fn check_length(&self, len: usize) -> Result<(), SdoAbort> {
         let size = usize::from(self.size);
-        let variable = matches!(self.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
+        let variable = matches!(self.data_type(), DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
         if len > size {
             Err(SdoAbort::LengthTooHigh)
         } else if len < size && !variable {
@@ -189,15 +286,15 @@ impl EntryInfo {
         // Fast path for the common entry without limits: a value of the right length always
         // fits its integer type, except a BOOLEAN byte holding 2..255.
         let Some(limits) = limits else {
-            return match (self.data_type, data) {
+            return match (self.data_type(), data) {
                 (DataType::Boolean, [b]) if *b > 1 => Err(SdoAbort::ValueTooHigh),
                 _ => Ok(()),
             };
         };
-        let Some(value) = Int::decode(self.data_type, data) else { return Ok(()) };
+        let Some(value) = Int::decode(self.data_type(), data) else { return Ok(()) };
         // Only BOOLEAN can carry bits its type does not allow (a byte holding 2..255): a value
         // of any other integer type fits it once its length is right.
-        if self.data_type == DataType::Boolean && value.above(1) {
+        if self.data_type() == DataType::Boolean && value.above(1) {
             return Err(SdoAbort::ValueTooHigh);
         }
         if !limits.values.is_empty() && !limits.values.iter().any(|&v| value.is(v)) {
@@ -283,15 +380,12 @@ pub(crate) const fn test_entry(data_type: DataType, access: Access, host_access:
     EntryInfo {
         index: 0x2000,
         object: 0,
+        size,
         sub: 0,
         last_sub: 0,
-        copies: 0,
-        data_type,
-        access,
-        host_access,
-        flags: EntryFlags::new(Storage::Ram, false, false, NmtStates::ALL),
-        size,
         limits: 0,
+        kind: EntryKind::new(data_type, access),
+        flags: EntryFlags::new(host_access, Storage::Ram),
     }
 }
 
@@ -347,7 +441,7 @@ mod tests {
         assert_eq!(m.check_write(Side::Host, &OP, &[1]), Err(SdoAbort::ReadOnly));
         // Not reachable from CAN at all (CO401GW1 100B).
         let n = Entry(EntryInfo {
-            flags: EntryFlags::new(Storage::Ram, false, true, NmtStates::ALL),
+            flags: EntryFlags::new(HostAccess::Rw, Storage::Ram).host_write_before_can_enabled(),
             ..info(DataType::Unsigned8, Access::None, HostAccess::Rw, 1).0
         });
         assert_eq!(n.check_read(Side::Bus), Err(SdoAbort::NoObject));
@@ -362,7 +456,7 @@ mod tests {
     fn writes_restricted_to_nmt_states() {
         let writable_in = NmtStates::NONE.with(NmtState::PreOperational);
         let e = Entry(EntryInfo {
-            flags: EntryFlags::new(Storage::Ram, false, false, writable_in),
+            flags: EntryFlags::new(HostAccess::None, Storage::Ram).writable_in(writable_in),
             ..info(DataType::Unsigned32, Access::Rw, HostAccess::None, 4).0
         });
         assert_eq!(e.check_write(Side::Bus, &PREOP, &[0; 4]), Ok(()));
@@ -434,10 +528,38 @@ mod tests {
     }
 
     #[test]
+    fn packed_properties_read_back_as_built() {
+        let accesses = [Access::Ro, Access::Wo, Access::Rw, Access::Rwr, Access::Rww, Access::Const, Access::None];
+        for (data_type, access) in DataType::ALL.into_iter().flat_map(|t| accesses.map(|a| (t, a))) {
+            let e = EntryInfo { kind: EntryKind::new(data_type, access), ..test_entry(DataType::Boolean, Access::Ro, HostAccess::None, 1) };
+            assert_eq!((e.data_type(), e.access()), (data_type, access));
+        }
+        let states = [NmtStates::NONE, NmtStates::ALL, NmtStates::NONE.with(NmtState::PreOperational), NmtStates::NONE.with(NmtState::Stopped)];
+        for host in [HostAccess::None, HostAccess::Ro, HostAccess::Wo, HostAccess::Rw] {
+            for storage in [Storage::Ram, Storage::Persistent, Storage::App] {
+                for (pdo, before, writable_in, copies) in (0..32_u8).flat_map(|c| states.map(|s| (c % 2 == 0, c % 3 == 0, s, c))) {
+                    let mut flags = EntryFlags::new(host, storage).writable_in(writable_in).copies(copies);
+                    if pdo {
+                        flags = flags.pdo_mappable();
+                    }
+                    if before {
+                        flags = flags.host_write_before_can_enabled();
+                    }
+                    let e = EntryInfo { flags, ..test_entry(DataType::Boolean, Access::Ro, HostAccess::None, 1) };
+                    assert_eq!((e.host_access(), e.storage(), e.pdo_mappable(), e.host_write_before_can_enabled()), (host, storage, pdo, before));
+                    assert_eq!((e.writable_in(), e.copies()), (writable_in, copies));
+                }
+            }
+        }
+        assert_eq!(test_entry(DataType::Boolean, Access::Ro, HostAccess::None, 1).writable_in(), NmtStates::ALL, "writable in every state by default");
+    }
+
+    #[test]
     fn entry_info_is_small_enough_for_flash_tables() {
-        // Most of a dictionary's flash is this table: at most 16 bytes per run on any target
-        // (flags and limits are bytes; the limits are an index into the dictionary's table).
-        let most = 16;
+        // Most of a dictionary's flash is this table: 12 bytes per run on any target (was 20
+        // on Cortex-M), the small properties packed and the limits an index into the
+        // dictionary's table.
+        let most = 12;
         assert!(core::mem::size_of::<EntryInfo>() <= most, "{}", core::mem::size_of::<EntryInfo>());
     }
 }
