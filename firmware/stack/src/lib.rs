@@ -28,4 +28,5 @@ pub mod pdo;
 pub mod sdo;
 pub mod slcan;
 pub mod store;
+pub(crate) mod time;
 pub mod value;
