@@ -9,7 +9,8 @@
 //! - `pdo::rpdos(mode)` / `pdo::tpdos(mode)`: the default PDOs, with compile-time checks that
 //!   every mapping fits a CAN frame;
 //! - `Od<A>`: the typed dictionary and its `EntryAccess`/`NodeDictionary` dispatch;
-//! - `emcy::*`: the spec's emergencies; `serial::*`: the host protocol's codecs;
+//! - `emcy::*`: the spec's emergencies (`emcy::by_name` / `emcy::name_of` for hosts);
+//!   `serial::*`: the host protocol's codecs;
 //! - `hardware::*`: decoders of the configuration pins (node-ID, bit rates, configuration);
 //! - identity constants and the `Node<A, S>` alias.
 //!
