@@ -78,7 +78,7 @@ type Snapshot = ([(u16, u8, usize, [u8; VALUE]); MAX_WATCHED], usize);
 
 fn snapshot(node: &mut dyn NodeAccess, entries: &[EntryInfo]) -> Snapshot {
     let mut out = ([(0, 0, 0, [0; VALUE]); MAX_WATCHED], 0);
-    let watched = entries.iter().filter(|e| matches!(e.access, Access::Ro | Access::Const) && !STACK_MAINTAINED.contains(&e.index));
+    let watched = entries.iter().filter(|e| matches!(e.access(), Access::Ro | Access::Const) && !STACK_MAINTAINED.contains(&e.index));
     for e in watched {
         for sub in e.sub..=e.last_sub {
             let mut buf = [0; VALUE];

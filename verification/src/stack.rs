@@ -8,10 +8,10 @@ use coforge_stack::sdo::{SdoServer, SdoTarget};
 
 /// Four emergencies with overlapping register bits; two share a code.
 pub const EMERGENCIES: [EmcyDefault; 4] = [
-    EmcyDefault { name: "a", code: 0x2310, register: 0x03, manufacturer: [0; 5], reaction: Reaction::None, event: None, enabled_by: None },
-    EmcyDefault { name: "b", code: 0x8130, register: 0x11, manufacturer: [0; 5], reaction: Reaction::None, event: None, enabled_by: None },
-    EmcyDefault { name: "c", code: 0x1000, register: 0x01, manufacturer: [0, 0, 0, 0, 0x10], reaction: Reaction::None, event: None, enabled_by: None },
-    EmcyDefault { name: "d", code: 0x1000, register: 0x81, manufacturer: [0, 0, 0, 0, 0x20], reaction: Reaction::None, event: None, enabled_by: None },
+    EmcyDefault { code: 0x2310, register: 0x03, manufacturer: [0; 5], reaction: Reaction::None, event: None, enabled_by: None },
+    EmcyDefault { code: 0x8130, register: 0x11, manufacturer: [0; 5], reaction: Reaction::None, event: None, enabled_by: None },
+    EmcyDefault { code: 0x1000, register: 0x01, manufacturer: [0, 0, 0, 0, 0x10], reaction: Reaction::None, event: None, enabled_by: None },
+    EmcyDefault { code: 0x1000, register: 0x81, manufacturer: [0, 0, 0, 0, 0x20], reaction: Reaction::None, event: None, enabled_by: None },
 ];
 
 /// Any sequence of raises and clears (op bit 2: clear, bits 0..1: which emergency) keeps the

@@ -35,7 +35,7 @@ fn read(od: &mut impl EntryAccess, index: u16, sub: u8, side: Side) -> Result<Ve
 fn sweep(od: &mut impl EntryAccess, table: &[EntryInfo]) -> usize {
     let mut n = 0;
     for run in table {
-        for index in run.index..=run.index + u16::from(run.copies) {
+        for index in run.index..=run.index + u16::from(run.copies()) {
             for sub in run.sub..=run.last_sub {
                 let value = read(od, index, sub, Side::Device).unwrap_or_else(|a| panic!("{index:04X}.{sub}: {a:?}"));
                 assert!(value.len() <= usize::from(run.size), "{index:04X}.{sub}");

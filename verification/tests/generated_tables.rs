@@ -22,20 +22,20 @@ fn check(d: &Device, mode: Option<&str>, table: &[EntryInfo], rpdos: &[PdoDefaul
         for e in o.entries.iter().filter(|e| in_mode(&e.modes, mode)) {
             let info = find(table, o.index, e.sub).unwrap_or_else(|a| panic!("{ctx}: {:04X}.{} missing ({a:?})", o.index, e.sub));
             let what = format!("{ctx}: {:04X}.{}", o.index, e.sub);
-            assert_eq!(info.data_type, e.data_type, "{what}");
-            assert_eq!(info.access, e.access, "{what}");
-            assert_eq!(info.host_access, e.host_access, "{what}");
-            assert_eq!(info.host_write_before_can_enabled, e.host_write_when == WriteWhen::BeforeCanEnabled, "{what}");
-            assert_eq!(info.pdo_mappable, e.pdo_mapping, "{what}");
-            assert_eq!(info.storage, e.storage, "{what}");
+            assert_eq!(info.data_type(), e.data_type, "{what}");
+            assert_eq!(info.access(), e.access, "{what}");
+            assert_eq!(info.host_access(), e.host_access, "{what}");
+            assert_eq!(info.host_write_before_can_enabled(), e.host_write_when == WriteWhen::BeforeCanEnabled, "{what}");
+            assert_eq!(info.pdo_mappable(), e.pdo_mapping, "{what}");
+            assert_eq!(info.storage(), e.storage, "{what}");
             if let Some(bits) = e.data_type.bits() {
                 assert_eq!(u32::from(info.size), bits.div_ceil(8), "{what}");
             }
             covered += 1;
         }
     }
-    assert!(table.iter().all(|r| r.copies <= coforge_stack::pdo::mapping::MAX_COPIES), "{ctx}: copies fit the PDO mapping cache");
-    let in_table: usize = table.iter().map(|r| (usize::from(r.last_sub - r.sub) + 1) * (usize::from(r.copies) + 1)).sum();
+    assert!(table.iter().all(|r| r.copies() <= coforge_stack::pdo::mapping::MAX_COPIES), "{ctx}: copies fit the PDO mapping cache");
+    let in_table: usize = table.iter().map(|r| (usize::from(r.last_sub - r.sub) + 1) * (usize::from(r.copies()) + 1)).sum();
     assert_eq!(in_table, covered, "{ctx}: the table holds exactly the spec's entries");
     for (dir, generated) in [(PdoDir::Rx, rpdos), (PdoDir::Tx, tpdos)] {
         let want: Vec<_> = d.pdo.pdos.iter().filter(|p| p.dir == dir && in_mode(&p.modes, mode)).collect();
@@ -85,4 +85,32 @@ fn canopenia_tables_match_the_spec() {
     use canopenia::{Mode, od, pdo};
     let d = spec("canopenia.yaml");
     check(&d, None, od::entries(Mode::Default), pdo::rpdos(Mode::Default), pdo::tpdos(Mode::Default));
+}
+
+/// The host-only name lookup: every spec emergency of every mode is found by its name, and
+/// names nothing else.
+#[test]
+fn emergencies_are_found_by_their_spec_names() {
+    macro_rules! check_names {
+        ($krate:ident, $spec:literal) => {{
+            use $krate::{Mode, emcy};
+            let d = spec($spec);
+            for mode in Mode::ALL {
+                let spec_mode = (Mode::ALL.len() > 1).then(|| mode.name());
+                let listed: Vec<_> = d.emergencies.iter().filter(|e| in_mode(&e.modes, spec_mode)).collect();
+                assert_eq!(listed.len(), emcy::emergencies(mode).len(), "{} {mode:?}", $spec);
+                for (e, generated) in listed.iter().zip(emcy::emergencies(mode)) {
+                    let found = emcy::by_name(mode, &e.name).unwrap_or_else(|| panic!("{} {mode:?}: {} not found", $spec, e.name));
+                    assert_eq!(found, *generated, "{} {mode:?}: {}", $spec, e.name);
+                    assert_eq!((found.code, found.register), (e.code, e.error_register), "{}", e.name);
+                    assert_eq!(emcy::name_of(mode, generated), Some(e.name.as_str()));
+                }
+                assert_eq!(emcy::by_name(mode, "no_such_emergency"), None);
+            }
+        }};
+    }
+    check_names!(co401memory1, "co401memory1.yaml");
+    check_names!(co401gw1, "co401gw1.yaml");
+    check_names!(cr3101, "cr3101.yaml");
+    check_names!(canopenia, "canopenia.yaml");
 }

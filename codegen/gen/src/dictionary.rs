@@ -394,6 +394,10 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
                 emcy::emergencies(self.mode)
             }
 
+            fn emergency_named(&self, name: &str) -> Option<#stack::emcy::EmcyDefault> {
+                emcy::by_name(self.mode, name)
+            }
+
             fn new(mode: Mode, node_id: u8, app: A) -> Self {
                 Od::new(mode, node_id, app)
             }
@@ -422,6 +426,10 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
 
             fn entries(&self) -> &'static [#stack::od::EntryInfo] {
                 od::entries(self.mode)
+            }
+
+            fn limits(&self) -> &'static [#stack::od::Limits] {
+                &od::LIMITS
             }
 
             #[allow(unreachable_patterns)]

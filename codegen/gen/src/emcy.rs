@@ -1,5 +1,6 @@
-//! `emcy::emergencies(mode)`: the spec's emergencies as the stack's `EmcyDefault`, and one
-//! constant per emergency so device code raises them by name.
+//! `emcy::emergencies(mode)`: the spec's emergencies as the stack's `EmcyDefault`, one
+//! constant per emergency so device code raises them by name, and `emcy::by_name` /
+//! `emcy::name_of` for hosts (the names are only in images that call these).
 
 use crate::Options;
 use crate::modes::Modes;
@@ -8,7 +9,6 @@ use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
 fn emergency(e: &Emergency, stack: &TokenStream) -> TokenStream {
-    let name = &e.name;
     let code = crate::hex(e.code.into(), 4);
     let register = crate::hex(e.error_register.into(), 2);
     // Bytes the spec marks as varying (`xx`) start as zero; the device fills them in.
@@ -35,7 +35,6 @@ fn emergency(e: &Emergency, stack: &TokenStream) -> TokenStream {
     };
     quote! {
         #stack::emcy::EmcyDefault {
-            name: #name,
             code: #code,
             register: #register,
             manufacturer: [#(#manufacturer),*],
@@ -61,24 +60,49 @@ pub fn emcy_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream 
             quote!(#[doc = #doc] pub const #c: #stack::emcy::EmcyDefault = #value;)
         })
         .collect();
-    let mut statics = Vec::new();
-    let mut per_mode = Vec::new();
-    for (variant, mode) in &modes.variants {
-        let list: Vec<TokenStream> = d.emergencies.iter().filter(|e| in_mode(&e.modes, mode.as_deref())).map(|e| emergency(e, stack)).collect();
-        let count = crate::dec(list.len() as u64);
-        let name = format_ident!("EMCY_{}", variant.to_string().to_uppercase());
-        statics.push(quote!(static #name: [#stack::emcy::EmcyDefault; #count] = [#(#list),*];));
-        per_mode.push(quote!(&#name));
-    }
-    let select = modes.select(&per_mode);
+    let per_mode: Vec<Vec<TokenStream>> = modes
+        .variants
+        .iter()
+        .map(|(_, mode)| d.emergencies.iter().filter(|e| in_mode(&e.modes, mode.as_deref())).map(|e| emergency(e, stack)).collect())
+        .collect();
+    let (statics, select) = modes.tables("EMCY", &quote!(#stack::emcy::EmcyDefault), &per_mode);
+    // The spec names, in the order of each mode's table.
+    let names: Vec<Vec<TokenStream>> = modes
+        .variants
+        .iter()
+        .map(|(_, mode)| {
+            d.emergencies
+                .iter()
+                .filter(|e| in_mode(&e.modes, mode.as_deref()))
+                .map(|e| {
+                    let name = &e.name;
+                    quote!(#name)
+                })
+                .collect()
+        })
+        .collect();
+    let (name_statics, select_names) = modes.tables("NAMES", &quote!(&str), &names);
     quote! {
         /// The spec's emergencies.
         pub mod emcy {
             use super::Mode;
             #(#consts)*
             #(#statics)*
+            #(#name_statics)*
             /// The emergencies of `mode`.
             pub fn emergencies(mode: Mode) -> &'static [#stack::emcy::EmcyDefault] { #select }
+            /// The spec names of the emergencies of `mode`, in the order of [`emergencies`].
+            fn names(mode: Mode) -> &'static [&'static str] { #select_names }
+            /// The emergency of `mode` the spec calls `name` (hosts: fault injection).
+            pub fn by_name(mode: Mode, name: &str) -> Option<#stack::emcy::EmcyDefault> {
+                let at = names(mode).iter().position(|n| *n == name)?;
+                emergencies(mode).get(at).copied()
+            }
+            /// The spec name of `e`, one of the emergencies of `mode`.
+            pub fn name_of(mode: Mode, e: &#stack::emcy::EmcyDefault) -> Option<&'static str> {
+                let at = emergencies(mode).iter().position(|x| x == e)?;
+                names(mode).get(at).copied()
+            }
         }
     }
 }

@@ -5,7 +5,7 @@ use crate::modes::Modes;
 use coforge_spec::model::{Device, Entry, Object, Value, in_mode};
 use coforge_spec::types::{DataType, NmtState, WriteWhen};
 use proc_macro2::{Ident, Span, TokenStream};
-use quote::{format_ident, quote};
+use quote::quote;
 
 /// Value limits of an entry: (low, high, allowed values).
 type LimitsKey = (Option<i64>, Option<i64>, Vec<i64>);
@@ -128,41 +128,44 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
     let access = ident(&m.access);
     let host_access = ident(&m.host_access);
     let storage = ident(&m.storage);
-    let (before, pdo, size) = (m.host_write_before_can_enabled, m.pdo_mappable, crate::dec(m.size.into()));
-    let writable_in = match &m.writable_in {
-        None => quote!(#stack::od::NmtStates::ALL),
-        Some(states) => {
-            let states = states.iter().map(|s| ident(&format!("{s:?}")));
-            quote!(#stack::od::NmtStates::NONE #(.with(#stack::od::NmtState::#states))*)
-        }
-    };
+    let (before, pdo, size) = (&m.host_write_before_can_enabled, &m.pdo_mappable, crate::dec(m.size.into()));
+    // The flags spell out only what differs from `EntryFlags::new`.
+    let mut flags = quote!(#stack::od::EntryFlags::new(#stack::od::HostAccess::#host_access, #stack::od::Storage::#storage));
+    if *pdo {
+        flags = quote!(#flags.pdo_mappable());
+    }
+    if *before {
+        flags = quote!(#flags.host_write_before_can_enabled());
+    }
+    if let Some(states) = &m.writable_in {
+        let states = states.iter().map(|s| ident(&format!("{s:?}")));
+        flags = quote!(#flags.writable_in(#stack::od::NmtStates::NONE #(.with(#stack::od::NmtState::#states))*));
+    }
+    if r.copies != 0 {
+        flags = quote!(#flags.copies(#copies));
+    }
+    // 0: none; n: entry n - 1 of `od::LIMITS`.
     let limits = match &m.limits {
-        None => quote!(None),
+        None => 0,
         Some(key) => {
-            let n = limits.iter().position(|k| k == key).unwrap_or_else(|| {
+            let at = limits.iter().position(|k| k == key).unwrap_or_else(|| {
                 limits.push(key.clone());
                 limits.len() - 1
             });
-            let name = format_ident!("LIMITS_{}", n);
-            quote!(Some(&#name))
+            at + 1
         }
     };
+    let limits = crate::dec(limits as u64);
     quote! {
         #stack::od::EntryInfo {
             index: #index,
             object: #object,
+            size: #size,
             sub: #sub,
             last_sub: #last_sub,
-            copies: #copies,
-            data_type: #stack::od::DataType::#data_type,
-            access: #stack::od::Access::#access,
-            host_access: #stack::od::HostAccess::#host_access,
-            host_write_before_can_enabled: #before,
-            pdo_mappable: #pdo,
-            storage: #stack::od::Storage::#storage,
-            writable_in: #writable_in,
-            size: #size,
             limits: #limits,
+            kind: #stack::od::EntryKind::new(#stack::od::DataType::#data_type, #stack::od::Access::#access),
+            flags: #flags,
         }
     }
 }
@@ -170,31 +173,31 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
 pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let stack = &options.stack;
     let mut limits: Vec<LimitsKey> = Vec::new();
-    let mut tables = Vec::new();
-    let mut per_mode = Vec::new();
     let numbers = crate::dictionary::object_numbers(d);
-    for (variant, mode) in &modes.variants {
-        let runs = runs(d, mode.as_deref());
-        let count = crate::dec(runs.len() as u64);
-        let table = format_ident!("ENTRIES_{}", variant.to_string().to_uppercase());
-        let items: Vec<TokenStream> = runs.iter().map(|r| run_tokens(r, numbers.get(&r.index).copied().unwrap_or_default(), stack, &mut limits)).collect();
-        tables.push(quote! { static #table: [#stack::od::EntryInfo; #count] = [#(#items),*]; });
-        per_mode.push(quote!(&#table));
-    }
-    let limit_statics = limits.iter().enumerate().map(|(n, (low, high, values))| {
-        let name = format_ident!("LIMITS_{}", n);
-        let opt = |v: &Option<i64>| match v {
-            Some(v) => {
-                let v = proc_macro2::Literal::i64_unsuffixed(*v);
-                quote!(Some(#v))
-            }
-            None => quote!(None),
-        };
-        let values = values.iter().map(|v| proc_macro2::Literal::i64_unsuffixed(*v));
-        let (low, high) = (opt(low), opt(high));
-        quote! { static #name: #stack::od::Limits = #stack::od::Limits { low: #low, high: #high, values: &[#(#values),*] }; }
-    });
-    let select = modes.select(&per_mode);
+    let per_mode: Vec<Vec<TokenStream>> = modes
+        .variants
+        .iter()
+        .map(|(_, mode)| {
+            runs(d, mode.as_deref()).iter().map(|r| run_tokens(r, numbers.get(&r.index).copied().unwrap_or_default(), stack, &mut limits)).collect()
+        })
+        .collect();
+    let (tables, select) = modes.tables("ENTRIES", &quote!(#stack::od::EntryInfo), &per_mode);
+    let limit_items: Vec<TokenStream> = limits
+        .iter()
+        .map(|(low, high, values)| {
+            let opt = |v: &Option<i64>| match v {
+                Some(v) => {
+                    let v = proc_macro2::Literal::i64_unsuffixed(*v);
+                    quote!(Some(#v))
+                }
+                None => quote!(None),
+            };
+            let values = values.iter().map(|v| proc_macro2::Literal::i64_unsuffixed(*v));
+            let (low, high) = (opt(low), opt(high));
+            quote!(#stack::od::Limits { low: #low, high: #high, values: &[#(#values),*] })
+        })
+        .collect();
+    let limit_count = crate::dec(limit_items.len() as u64);
     // The SDO server buffers a download until its last segment: size the buffer for the
     // largest value the bus may write. Domains without a declared length do not count; a
     // download larger than the buffer is refused with "out of memory".
@@ -206,10 +209,13 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             use super::Mode;
             /// Bytes of the largest value the bus may write (the SDO download buffer).
             pub const MAX_WRITE_SIZE: usize = #max_write;
-            #(#limit_statics)*
+            /// Every distinct value limit of the dictionary: an entry's `limits` n is entry n - 1.
+            pub static LIMITS: [#stack::od::Limits; #limit_count] = [#(#limit_items),*];
             #(#tables)*
             /// Every entry of `mode`, sorted by index and sub-index; consecutive sub-entries that
             /// are described alike share one run (`sub..=last_sub`).
+            // Every engine looks entries up: one call each, not the `match` in every caller.
+            #[inline(never)]
             pub fn entries(mode: Mode) -> &'static [#stack::od::EntryInfo] {
                 #select
             }

@@ -5,11 +5,12 @@
 //! Generated per device:
 //! - `Mode`: the device's operating modes (`Mode::Default` for a device without modes);
 //! - `od::entries(mode)`: the sorted [`EntryInfo`] table, identical sub-entries merged into
-//!   runs, value limits in shared statics;
+//!   runs, value limits in one table (`od::LIMITS`) the runs index;
 //! - `pdo::rpdos(mode)` / `pdo::tpdos(mode)`: the default PDOs, with compile-time checks that
 //!   every mapping fits a CAN frame;
 //! - `Od<A>`: the typed dictionary and its `EntryAccess`/`NodeDictionary` dispatch;
-//! - `emcy::*`: the spec's emergencies; `serial::*`: the host protocol's codecs;
+//! - `emcy::*`: the spec's emergencies (`emcy::by_name` / `emcy::name_of` for hosts);
+//!   `serial::*`: the host protocol's codecs;
 //! - `index::*`: every object's index by name; `app::Hooks`: one typed hook per app-backed
 //!   object (group), routed by `app::Typed<H>`;
 //! - `node_config`: the node settings of the spec's `node:` section;

@@ -43,4 +43,29 @@ impl Modes {
         let arms = self.variants.iter().zip(per_mode).map(|((v, _), e)| quote!(Mode::#v => #e));
         quote!(match mode { #(#arms),* })
     }
+
+    /// One `static PREFIX_MODE: [ty; n]` per distinct table of `per_mode` (the items of each
+    /// mode's table), named after the first mode that has it, and the `match mode` returning
+    /// each mode's: rustc does not merge identical statics, so modes with equal tables share one.
+    pub fn tables(&self, prefix: &str, ty: &TokenStream, per_mode: &[Vec<TokenStream>]) -> (Vec<TokenStream>, TokenStream) {
+        let mut statics = Vec::new();
+        // (the items as text, the static's name) of each table emitted so far.
+        let mut emitted: Vec<(String, Ident)> = Vec::new();
+        let mut refs = Vec::new();
+        for ((variant, _), items) in self.variants.iter().zip(per_mode) {
+            let key = quote!(#(#items),*).to_string();
+            let name = match emitted.iter().find(|(k, _)| *k == key) {
+                Some((_, name)) => name.clone(),
+                None => {
+                    let name = Ident::new(&format!("{prefix}_{}", variant.to_string().to_uppercase()), Span::call_site());
+                    let count = proc_macro2::Literal::usize_unsuffixed(items.len());
+                    statics.push(quote!(static #name: [#ty; #count] = [#(#items),*];));
+                    emitted.push((key, name.clone()));
+                    name
+                }
+            };
+            refs.push(quote!(&#name));
+        }
+        (statics, self.select(&refs))
+    }
 }

@@ -40,17 +40,14 @@ pub fn pdo_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let mut statics = Vec::new();
     let mut selects = Vec::new();
     for (dir, fname) in [(PdoDir::Rx, "rpdos"), (PdoDir::Tx, "tpdos")] {
-        let mut per_mode = Vec::new();
-        for (variant, mode) in &modes.variants {
-            let pdos: Vec<TokenStream> =
-                d.pdo.pdos.iter().filter(|p| p.dir == dir && in_mode(&p.modes, mode.as_deref())).map(|p| pdo_tokens(p, stack)).collect();
-            let count = crate::dec(pdos.len() as u64);
-            let name = format_ident!("{}_{}", fname.to_uppercase(), variant.to_string().to_uppercase());
-            statics.push(quote! { static #name: [#stack::pdo::PdoDefault; #count] = [#(#pdos),*]; });
-            per_mode.push(quote!(&#name));
-        }
+        let per_mode: Vec<Vec<TokenStream>> = modes
+            .variants
+            .iter()
+            .map(|(_, mode)| d.pdo.pdos.iter().filter(|p| p.dir == dir && in_mode(&p.modes, mode.as_deref())).map(|p| pdo_tokens(p, stack)).collect())
+            .collect();
+        let (tables, select) = modes.tables(&fname.to_uppercase(), &quote!(#stack::pdo::PdoDefault), &per_mode);
+        statics.extend(tables);
         let f = format_ident!("{}", fname);
-        let select = modes.select(&per_mode);
         let doc = format!("The default {}s of `mode`, by number.", dir.name());
         selects.push(quote! {
             #[doc = #doc]

@@ -198,23 +198,17 @@ fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
             }
             None => quote!(None),
         };
-        let (min, max) = (crate::dec(c.length.0.into()), crate::dec(c.length.1.into()));
-        let build = if decls.is_empty() { quote!(Self::#v) } else { quote!(Self::#v { #(#reads),* }) };
-        let length_check = if c.length_code.is_some() {
-            quote!()
-        } else {
-            quote! {
-                if !(#min..=#max).contains(&data.len()) {
-                    return Err(::coforge_link::fields::DecodeError::Length { min: #min, max: #max, got: data.len() });
-                }
+        // A length code stands for the whole length: any data length passes.
+        let (min, max) = match c.length_code {
+            Some(_) => (quote!(0), quote!(usize::MAX)),
+            None => {
+                let (min, max) = (crate::dec(c.length.0.into()), crate::dec(c.length.1.into()));
+                (quote!(#min), quote!(#max))
             }
         };
-        decode_arms.push(quote! {
-            if #code_test && frame.length_code == #lc {
-                #length_check
-                return Ok(#build);
-            }
-        });
+        let build = if decls.is_empty() { quote!(Self::#v) } else { quote!(Self::#v { #(#reads),* }) };
+        let number = crate::dec(decode_arms.len() as u64);
+        decode_arms.push((quote!(#code_test && frame.length_code == #lc), quote!((#number, #min, #max)), number, build));
         // Encoding: fields into a buffer, then the framing.
         let code_expr = match &c.code_param {
             None => quote!(#code),
@@ -245,16 +239,22 @@ fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
         let pattern = if names.is_empty() { quote!(Self::#v) } else { quote!(Self::#v { #(#names),* }) };
         encode_arms.push(quote! {
             #pattern => {
-                let mut buf = [0_u8; MAX_DATA];
                 #(#writes;)*
-                let len = #len;
-                put_frame(#code_expr, #lc, buf.get(..len).unwrap_or(&[]), out)
+                (#code_expr, #lc, #len)
             }
         });
         let name = &c.name;
         let name_pattern = if names.is_empty() { quote!(Self::#v) } else { quote!(Self::#v { .. }) };
         name_arms.push(quote!(#name_pattern => #name));
     }
+    // Decoding in two steps, so that the length check and its error exist once: which
+    // command (the first whose code and length code match) with its length range, then its
+    // fields. The last command is the catch-all arm of the second match.
+    let tests = decode_arms.iter().map(|(test, found, _, _)| quote!(if #test { #found }));
+    let builds = decode_arms
+        .iter()
+        .enumerate()
+        .map(|(i, (_, _, number, build))| if i + 1 == decode_arms.len() { quote!(_ => #build) } else { quote!(#number => #build) });
     quote! {
         #[derive(Debug, Clone, Copy, PartialEq, Eq)]
         pub enum #enum_name #lt { #(#variants),* }
@@ -263,14 +263,22 @@ fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
             /// The command a decoded frame carries.
             pub fn decode(frame: &::coforge_link::Frame #lt) -> Result<Self, ::coforge_link::fields::DecodeError> {
                 let data = frame.data;
-                #(#decode_arms)*
-                Err(::coforge_link::fields::DecodeError::UnknownCommand { code: frame.code })
+                let (command, min, max): (u8, usize, usize) = #(#tests else)* {
+                    return Err(::coforge_link::fields::DecodeError::UnknownCommand { code: frame.code });
+                };
+                if !(min..=max).contains(&data.len()) {
+                    return Err(::coforge_link::fields::DecodeError::Length { min, max, got: data.len() });
+                }
+                Ok(match command { #(#builds),* })
             }
 
             /// Writes the whole frame into `out`; returns its length.
             #[allow(unused_mut, unused_variables)]
             pub fn encode(&self, out: &mut [u8]) -> Result<usize, ::coforge_link::EncodeError> {
-                match self { #(#encode_arms),* }
+                // The fields go into one buffer, then through the framing.
+                let mut buf = [0_u8; MAX_DATA];
+                let (code, length_code, len): (u8, Option<u8>, usize) = match self { #(#encode_arms),* };
+                put_frame(code, length_code, buf.get(..len).unwrap_or(&[]), out)
             }
 
             /// The command's name in the spec.

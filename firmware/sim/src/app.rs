@@ -17,7 +17,7 @@ impl AppObjects for RamApp {
             Some(v) => v.as_slice(),
             None => {
                 // Variable-length entries start empty; fixed-size ones read as zero.
-                let len = if entry.data_type.bits().is_some() { usize::from(entry.size) } else { 0 };
+                let len = if entry.data_type().bits().is_some() { usize::from(entry.size) } else { 0 };
                 zeros = vec![0; len];
                 zeros.as_slice()
             }

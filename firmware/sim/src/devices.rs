@@ -36,20 +36,20 @@ pub trait SimDevice: Device + Console + Send {}
 impl<T: Device + Console + Send> SimDevice for T {}
 
 /// The spec emergency called `name` in the node's mode (fault injection by name).
-pub fn emergency(node: &dyn NodeAccess, name: &str) -> Option<&'static EmcyDefault> {
-    node.emergencies().iter().find(|e| e.name == name)
+pub fn emergency(node: &dyn NodeAccess, name: &str) -> Option<EmcyDefault> {
+    node.emergency_named(name)
 }
 
 /// Raises the spec emergency called `name`; `false` if there is none.
 pub fn raise(device: &mut dyn SimDevice, name: &str) -> bool {
     let found = emergency(device.node(), name);
-    found.map(|e| device.node_mut().raise(e)).is_some()
+    found.map(|e| device.node_mut().raise(&e)).is_some()
 }
 
 /// Ends the spec emergency called `name`; `false` if there is none.
 pub fn clear(device: &mut dyn SimDevice, name: &str) -> bool {
     let found = emergency(device.node(), name);
-    found.map(|e| device.node_mut().clear(e)).is_some()
+    found.map(|e| device.node_mut().clear(&e)).is_some()
 }
 
 /// Where a simulated device keeps its non-volatile memory.

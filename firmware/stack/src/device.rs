@@ -82,6 +82,9 @@ pub trait NodeAccess {
     /// The spec's emergencies in the dictionary's mode.
     fn emergencies(&self) -> &'static [EmcyDefault];
 
+    /// The spec emergency called `name` in the dictionary's mode (host tools).
+    fn emergency_named(&self, name: &str) -> Option<EmcyDefault>;
+
     fn raise(&mut self, e: &EmcyDefault);
 
     fn clear(&mut self, e: &EmcyDefault);
@@ -183,6 +186,9 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> NodeAcces
     }
     fn emergencies(&self) -> &'static [EmcyDefault] {
         self.od().emergencies()
+    }
+    fn emergency_named(&self, name: &str) -> Option<EmcyDefault> {
+        self.od().emergency_named(name)
     }
     fn raise(&mut self, e: &EmcyDefault) {
         Node::raise(self, e);

@@ -17,10 +17,10 @@ pub enum Reaction {
     Stopped,
 }
 
-/// An emergency as the spec lists it.
+/// An emergency as the spec lists it. Its spec name is not here, so that no image carries
+/// the names: hosts find emergencies by name through the generated `emcy::by_name`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EmcyDefault {
-    pub name: &'static str,
     pub code: u16,
     pub register: u8,
     /// Bytes 3..7 (bytes the spec marks as varying are zero).
@@ -35,7 +35,6 @@ impl EmcyDefault {
     /// The spec emergency for `event`, or the CiA 301 one.
     pub fn for_event(event: EmcyEvent, spec: &'static [EmcyDefault]) -> EmcyDefault {
         spec.iter().find(|e| e.event == Some(event)).copied().unwrap_or(EmcyDefault {
-            name: event.name(),
             code: event.default_code(),
             // Every stack event is a communication error: generic + communication bits.
             register: 0x11,
@@ -191,15 +190,8 @@ impl EmcyProducer {
 mod tests {
     use super::*;
 
-    const OVERLOAD: EmcyDefault = EmcyDefault {
-        name: "overload",
-        code: 0x2310,
-        register: 0x03,
-        manufacturer: [0, 1, 0, 0, 0],
-        reaction: Reaction::ErrorBehaviour,
-        event: None,
-        enabled_by: None,
-    };
+    const OVERLOAD: EmcyDefault =
+        EmcyDefault { code: 0x2310, register: 0x03, manufacturer: [0, 1, 0, 0, 0], reaction: Reaction::ErrorBehaviour, event: None, enabled_by: None };
 
     #[test]
     fn raising_and_clearing_keeps_the_register_consistent() {
@@ -231,16 +223,8 @@ mod tests {
 
     #[test]
     fn a_combining_producer_ors_the_codes_of_every_active_error() {
-        let bank1 = EmcyDefault {
-            name: "bank1",
-            code: 0x1000,
-            register: 0x01,
-            manufacturer: [0, 0x10, 0, 0, 0],
-            reaction: Reaction::None,
-            event: None,
-            enabled_by: None,
-        };
-        let low = EmcyDefault { name: "low", manufacturer: [0, 0x40, 0, 0, 0], ..bank1 };
+        let bank1 = EmcyDefault { code: 0x1000, register: 0x01, manufacturer: [0, 0x10, 0, 0, 0], reaction: Reaction::None, event: None, enabled_by: None };
+        let low = EmcyDefault { manufacturer: [0, 0x40, 0, 0, 0], ..bank1 };
         let mut p = EmcyProducer::combining();
         p.raise(&bank1);
         p.raise(&low);

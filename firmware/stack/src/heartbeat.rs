@@ -14,7 +14,7 @@ impl Producer {
     /// A new period (a 1017h write, or a reset); the first heartbeat follows one period later.
     pub fn configure(&mut self, period_ms: u16, now_us: u64) {
         self.period_ms = period_ms;
-        self.next_us = (period_ms != 0).then(|| now_us.saturating_add(u64::from(period_ms) * 1000));
+        self.next_us = (period_ms != 0).then(|| crate::time::later_us(now_us, period_ms.into(), 1000));
     }
 
     pub const fn period_ms(&self) -> u16 {
@@ -26,9 +26,8 @@ impl Producer {
         match self.next_us {
             Some(t) if now_us >= t => {
                 // Keep the period stable even if polled late, but never burst to catch up.
-                let period = u64::from(self.period_ms) * 1000;
-                let next = t.saturating_add(period);
-                self.next_us = Some(if next > now_us { next } else { now_us.saturating_add(period) });
+                let next = crate::time::later_us(t, self.period_ms.into(), 1000);
+                self.next_us = Some(if next > now_us { next } else { crate::time::later_us(now_us, self.period_ms.into(), 1000) });
                 true
             }
             _ => false,

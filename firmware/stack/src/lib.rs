@@ -30,4 +30,5 @@ pub mod od;
 pub mod pdo;
 pub mod sdo;
 pub mod store;
+pub(crate) mod time;
 pub mod value;

@@ -1,12 +1,32 @@
 //! How typed dictionary fields are read and written as little-endian bytes.
 
-use crate::od::{EntryInfo, ReadLen, SdoAbort, decode_int, read_slice};
+use crate::od::entry::Int;
+use crate::od::{EntryInfo, ReadLen, SdoAbort, read_slice};
 
 /// A value stored in a dictionary field. `write` gets data that already passed the access,
 /// length and range checks of [`EntryInfo::check_write`].
 pub trait OdValue {
     fn read(&self, entry: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
     fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort>;
+}
+
+/// The two's-complement bits of what `data` stores in an integer field of `width` bytes
+/// (`signed` or not): a full-width value as it is, a narrower one (the 24/40/48/56-bit types
+/// live in the next wider Rust integer) decoded by the entry's type and refused with
+/// `ValueTooHigh` if the field cannot hold it. One function for every integer type, which
+/// then only truncates.
+fn int_bits(entry: &EntryInfo, data: &[u8], width: usize, signed: bool) -> Result<u64, SdoAbort> {
+    if data.len() == width {
+        return Ok(data.iter().rev().fold(0_u64, |acc, &b| acc << 8 | u64::from(b)));
+    }
+    // The field's range: 0..=2^bits - 1, or -2^(bits - 1)..=2^(bits - 1) - 1.
+    let unused = 64_u32.saturating_sub(8 * width as u32);
+    let (min, max) = if signed { (i64::MIN >> unused, u64::MAX >> (unused + 1)) } else { (0, u64::MAX >> unused) };
+    match Int::decode(entry.data_type(), data).ok_or(SdoAbort::LengthMismatch)? {
+        Int::Signed(v) if v >= min && u64::try_from(v).map_or(true, |v| v <= max) => Ok(v as u64),
+        Int::Unsigned(v) if v <= max => Ok(v),
+        _ => Err(SdoAbort::ValueTooHigh),
+    }
 }
 
 macro_rules! integer_value {
@@ -18,13 +38,8 @@ macro_rules! integer_value {
                 read_slice(bytes.get(..usize::from(entry.size)).unwrap_or(&bytes), offset, buf)
             }
             fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
-                // Full-width values (all but the 24/40/48/56-bit types) need no sign extension.
-                if let Ok(bytes) = data.try_into() {
-                    *self = <$t>::from_le_bytes(bytes);
-                    return Ok(());
-                }
-                let value = decode_int(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)?;
-                *self = <$t>::try_from(value).map_err(|_| SdoAbort::ValueTooHigh)?;
+                // In range by `int_bits`: the cast keeps the value.
+                *self = int_bits(entry, data, size_of::<$t>(), <$t>::MIN != 0)? as $t;
                 Ok(())
             }
         }
@@ -38,7 +53,7 @@ impl OdValue for bool {
         read_slice(&[u8::from(*self)], offset, buf)
     }
     fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
-        *self = decode_int(entry.data_type, data).ok_or(SdoAbort::LengthMismatch)? != 0;
+        *self = !Int::decode(entry.data_type(), data).ok_or(SdoAbort::LengthMismatch)?.is(0);
         Ok(())
     }
 }
@@ -126,6 +141,35 @@ mod tests {
         let mut u: u16 = 0;
         u.write(&info(DataType::Unsigned16, 2), &[0x34, 0x12]).unwrap();
         assert_eq!(u, 0x1234);
+    }
+
+    #[test]
+    fn integer_writes_store_what_fits_the_field_as_the_exact_conversion_does() {
+        let mut x = 3_u64;
+        macro_rules! check {
+            ($($t:ty),*) => {$(
+                for t in DataType::ALL {
+                    let Some(bits) = t.bits() else { continue };
+                    let len = bits.div_ceil(8) as usize;
+                    for n in 0..300 {
+                        x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                        let raw = [0, u64::MAX, x][n.min(2)];
+                        let data = &raw.to_le_bytes()[..len];
+                        let mut v: $t = 0 as $t;
+                        let got = v.write(&info(t, len as u16), data).map(|()| v);
+                        // Full width: the bytes as they are; narrower: the decoded value, if it fits.
+                        let want = match <[u8; size_of::<$t>()]>::try_from(data) {
+                            Ok(bytes) => Ok(<$t>::from_le_bytes(bytes)),
+                            Err(_) => crate::od::decode_int(t, data)
+                                .ok_or(SdoAbort::LengthMismatch)
+                                .and_then(|v| <$t>::try_from(v).map_err(|_| SdoAbort::ValueTooHigh)),
+                        };
+                        assert_eq!(got, want, "{} as {t}: {data:02X?}", stringify!($t));
+                    }
+                }
+            )*};
+        }
+        check!(u8, u16, u32, u64, i8, i16, i32, i64);
     }
 
     #[test]

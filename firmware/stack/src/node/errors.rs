@@ -60,10 +60,11 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     /// sent if the spec lists them: the guarding warning, and bus-off and its end (a node
     /// cannot send while bus-off; datasheets differ in what goes out on the return).
     pub(super) fn event_emcy(&self, event: EmcyEvent) -> Option<EmcyDefault> {
-        let spec = self.od.emergencies();
-        match event {
-            EmcyEvent::GuardingWarning | EmcyEvent::BusOff | EmcyEvent::BusOffRecovered => spec.iter().find(|e| e.event == Some(event)).copied(),
-            _ => Some(EmcyDefault::for_event(event, spec)),
+        // One search of the spec's list; the CiA 301 default only where none is listed.
+        match (self.od.emergencies().iter().find(|e| e.event == Some(event)), event) {
+            (Some(e), _) => Some(*e),
+            (None, EmcyEvent::GuardingWarning | EmcyEvent::BusOff | EmcyEvent::BusOffRecovered) => None,
+            (None, _) => Some(EmcyDefault::for_event(event, &[])),
         }
     }
 

@@ -13,14 +13,14 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         let ctx = self.ctx();
         let entry = self.od.entry(index, sub)?;
         if matches!(index, 0x1010 | 0x1011) && sub >= 1 {
-            entry.check_write(side, &ctx, data)?;
+            entry.check_write(side, &ctx, data, self.od.limits())?;
             return self.store_command(index, sub, data);
         }
         self.check_communication(index, sub, data, side)?;
         entry.check_write_access(side, &ctx)?;
         self.od.write_entry(entry, index, sub, data)?;
         self.after_write(index, sub);
-        if self.cfg.auto_save && entry.storage == Storage::Persistent && side != Side::Device {
+        if self.cfg.auto_save && entry.storage() == Storage::Persistent && side != Side::Device {
             self.store.save(&self.od, crate::od::Area::ALL).map_err(|_| SdoAbort::Hardware)?;
         }
         Ok(())
@@ -119,7 +119,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, 
 
     fn fixed_size(&mut self, index: u16, sub: u8) -> Option<usize> {
         let e = self.od.entry(index, sub).ok()?;
-        e.data_type.bits().map(|_| usize::from(e.size))
+        e.data_type().bits().map(|_| usize::from(e.size))
     }
 }
 

@@ -1,7 +1,7 @@
 //! The traits generated dictionaries implement: entry access (`EntryAccess`), what a node
 //! needs beyond it (`NodeDictionary`), and the owner of app-backed objects (`AppObjects`).
 
-use super::{AccessContext, EntryInfo, ReadLen, SdoAbort, Side, find};
+use super::{AccessContext, EntryInfo, Limits, ReadLen, SdoAbort, Side, find};
 use crate::value::OdValue;
 use coforge_types::Storage;
 
@@ -17,6 +17,9 @@ pub trait EntryAccess {
     /// Every entry description, sorted by index and sub-index (see [`find`]).
     fn entries(&self) -> &'static [EntryInfo];
 
+    /// The value limits the entries' `limits` indices refer to.
+    fn limits(&self) -> &'static [Limits];
+
     /// The field that stores `sub` of the entry `info` describes, `info` being the run
     /// [`find_run`] gave for it (so `info.covers(sub)`; single-entry objects do not look at
     /// `sub` again); `None` for an entry the dictionary does not store (app-backed ones).
@@ -28,7 +31,7 @@ pub trait EntryAccess {
     /// Reads the value of `index`/`sub`, which `info` describes, from byte `offset` into
     /// `buf`: no lookup and no access check (the caller made both).
     fn read_entry(&mut self, info: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
-        if info.storage == Storage::App {
+        if info.storage() == Storage::App {
             return self.app().read(info, index, sub, offset, buf);
         }
         self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.read(info, offset, buf)
@@ -37,8 +40,8 @@ pub trait EntryAccess {
     /// Writes `data` (the whole value, little-endian) after its length and value checks; no
     /// lookup and no access check. A refused write leaves the stored value unchanged.
     fn write_entry(&mut self, info: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
-        info.check_data(data)?;
-        if info.storage == Storage::App {
+        info.check_data(data, self.limits())?;
+        if info.storage() == Storage::App {
             return self.app().write(info, index, sub, data);
         }
         self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.write(info, data)
@@ -149,6 +152,10 @@ pub trait NodeDictionary: EntryAccess {
 
     /// The spec's emergencies in the dictionary's mode.
     fn emergencies(&self) -> &'static [crate::emcy::EmcyDefault];
+
+    /// The spec emergency of the dictionary's mode called `name` (hosts: fault injection;
+    /// firmware that never asks leaves the names out of its image).
+    fn emergency_named(&self, name: &str) -> Option<crate::emcy::EmcyDefault>;
 
     /// The dictionary with the spec's defaults of `mode`, `$NODEID` resolved for `node_id`.
     fn new(mode: Self::Mode, node_id: u8, app: Self::App) -> Self

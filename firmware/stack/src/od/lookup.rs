@@ -70,7 +70,10 @@ mod tests {
 
     #[test]
     fn repeated_objects_resolve_through_their_first_index() {
-        let at = |index, sub, last_sub, copies| EntryInfo { index, sub, last_sub, copies, ..info(DataType::Unsigned8, Access::Ro, HostAccess::Ro, 1) };
+        let at = |index, sub, last_sub, copies| {
+            let e = info(DataType::Unsigned8, Access::Ro, HostAccess::Ro, 1);
+            EntryInfo { index, sub, last_sub, flags: e.flags.copies(copies), ..e }
+        };
         // 5000..5003 alike (sub 0 and 1..=128), then 5C00 with subs 0..=2.
         let table = [at(0x1000, 0, 0, 0), at(0x5000, 0, 0, 3), at(0x5000, 1, 128, 3), at(0x5C00, 0, 2, 0)];
         for index in 0x5000..=0x5003 {

@@ -23,7 +23,7 @@ pub mod side;
 pub use abort::SdoAbort;
 pub use coforge_types::{Access, DataType, HostAccess, NmtState, Storage};
 pub use dictionary::{AppObjects, Area, CommObjects, EntryAccess, NoAppObjects, NodeDictionary, mode_named};
-pub use entry::{EntryInfo, Limits, ReadLen, decode_int};
+pub use entry::{EntryFlags, EntryInfo, EntryKind, Limits, ReadLen, decode_int};
 pub use lookup::{find, find_run, read_slice};
 pub use side::{AccessContext, NmtStates, Side};
 

@@ -36,6 +36,16 @@ impl NmtStates {
     pub const fn contains(self, state: NmtState) -> bool {
         self.0 & Self::bit(state) != 0
     }
+
+    /// The set as three bits, for [`EntryFlags`](super::entry::EntryFlags).
+    pub(crate) const fn bits(self) -> u8 {
+        self.0
+    }
+
+    /// The set in the low three bits of `bits`.
+    pub(crate) const fn from_bits(bits: u8) -> NmtStates {
+        NmtStates(bits & Self::ALL.0)
+    }
 }
 
 /// What a write is judged against besides the entry itself.

@@ -85,16 +85,16 @@ pub fn check_entry(od: &impl EntryAccess, word: u32, dir: Dir) -> Result<Mapped,
     let run = find_run(entries, index, sub)?;
     let e = entries.get(run).ok_or(SdoAbort::NoObject)?;
     let allowed = match dir {
-        Dir::Rx => e.access.writable(),
-        Dir::Tx => e.access.readable(),
+        Dir::Rx => e.access().writable(),
+        Dir::Tx => e.access().readable(),
     };
-    if !e.pdo_mappable || !allowed {
+    if !e.pdo_mappable() || !allowed {
         return Err(SdoAbort::NotMappable);
     }
-    let variable = matches!(e.data_type, DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
+    let variable = matches!(e.data_type(), DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
     let fits = if variable { u16::from(bytes) <= e.size } else { u16::from(bytes) == e.size };
     let run = u16::try_from(run).map_err(|_| SdoAbort::NotMappable)?;
-    // `find_run` only returns a run that covers `index`, so the copy is at most `e.copies`.
+    // `find_run` only returns a run that covers `index`, so the copy is at most `e.copies()`.
     let copy = u8::try_from(index - e.index).map_err(|_| SdoAbort::NotMappable)?;
     if fits { Ok(Mapped::new(run, copy, sub, bytes)) } else { Err(SdoAbort::NotMappable) }
 }

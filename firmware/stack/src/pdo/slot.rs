@@ -109,7 +109,7 @@ impl Rpdo {
     /// A reception at `now_us`: restarts deadline monitoring. True if it ends a timeout.
     pub fn received(&mut self, now_us: u64) -> bool {
         if self.comm.event_timer != 0 {
-            self.deadline_us = now_us.saturating_add(u64::from(self.comm.event_timer) * 1000);
+            self.deadline_us = crate::time::later_us(now_us, self.comm.event_timer.into(), 1000);
         }
         core::mem::take(&mut self.timed_out)
     }
@@ -175,7 +175,7 @@ impl Tpdo {
         self.waiting_for_start = self.comm.sync_start != 0;
         self.inhibit_until_us = now_us;
         self.event_due_us =
-            if self.comm.event_driven() && self.comm.event_timer != 0 { now_us.saturating_add(u64::from(self.comm.event_timer) * 1000) } else { NEVER };
+            if self.comm.event_driven() && self.comm.event_timer != 0 { crate::time::later_us(now_us, self.comm.event_timer.into(), 1000) } else { NEVER };
     }
 
     /// Whether a SYNC with optional `counter` makes this TPDO send (types 0..=240), or
@@ -227,9 +227,9 @@ impl Tpdo {
     /// Records a transmission at `now_us`: inhibit time and event timer restart.
     pub fn sent(&mut self, now_us: u64) {
         self.pending = false;
-        self.inhibit_until_us = now_us.saturating_add(u64::from(self.comm.inhibit_time) * 100);
+        self.inhibit_until_us = crate::time::later_us(now_us, self.comm.inhibit_time.into(), 100);
         if self.comm.event_driven() && self.comm.event_timer != 0 {
-            self.event_due_us = now_us.saturating_add(u64::from(self.comm.event_timer) * 1000);
+            self.event_due_us = crate::time::later_us(now_us, self.comm.event_timer.into(), 1000);
         }
     }
 }

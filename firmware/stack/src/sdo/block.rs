@@ -15,10 +15,32 @@ use crate::od::SdoAbort;
 /// The largest sub-block CiA 301 allows.
 const MAX_BLKSIZE: u8 = 127;
 
+/// `n / SEGMENT_DATA` (7) without a division instruction, which a Cortex-M0 lacks: these
+/// are the server's only divisions by a number that is not a power of two, and a libcall
+/// would link the 400-byte software divider.
+fn whole_segments(n: usize) -> usize {
+    const _: () = assert!(SEGMENT_DATA == 7);
+    match u32::try_from(n) {
+        // Multiply-high by 2^32/7 rounded up, then the add-back step that makes it exact for
+        // every u32 (Hacker's Delight 10-8).
+        Ok(n) => {
+            let high = ((u64::from(n) * 0x2492_4925) >> 32) as u32;
+            ((((n - high) >> 1) + high) >> 2) as usize
+        }
+        Err(_) => n / SEGMENT_DATA,
+    }
+}
+
+/// Segments that `n` bytes take: `n.div_ceil(SEGMENT_DATA)`.
+fn segments_for(n: usize) -> usize {
+    let whole = whole_segments(n);
+    if whole * SEGMENT_DATA == n { whole } else { whole + 1 }
+}
+
 /// Segments per sub-block the server can take with `free` bytes of buffer left: what fits,
 /// at least 1 (the last segment may be short) and at most 127.
 fn blksize_for(free: usize) -> u8 {
-    u8::try_from(free / SEGMENT_DATA).unwrap_or(MAX_BLKSIZE).clamp(1, MAX_BLKSIZE)
+    u8::try_from(whole_segments(free)).unwrap_or(MAX_BLKSIZE).clamp(1, MAX_BLKSIZE)
 }
 
 /// A client's block size: 1..=127, else `InvalidBlockSize`.
@@ -164,7 +186,7 @@ pub(super) fn initiate_upload(mux: Mux, crc: bool, blksize: u8, pst: u8, target:
 impl Upload {
     /// Segments the value takes; an empty value still sends one (empty, last) segment.
     fn segments(&self) -> usize {
-        self.total.div_ceil(SEGMENT_DATA).max(1)
+        segments_for(self.total).max(1)
     }
 
     /// The first sub-block from where the client acknowledged.
@@ -252,5 +274,27 @@ mod tests {
         assert_eq!(check_blksize(0), Err(SdoAbort::InvalidBlockSize));
         assert_eq!(check_blksize(128), Err(SdoAbort::InvalidBlockSize));
         assert_eq!(check_blksize(127), Ok(127));
+    }
+
+    #[test]
+    fn segment_counts_equal_the_divisions() {
+        let check = |n: usize| {
+            assert_eq!(whole_segments(n), n / 7, "{n}");
+            assert_eq!(segments_for(n), n.div_ceil(7), "{n}");
+        };
+        (0..200_000).for_each(check);
+        // Near every power of two, the ends of u32 and, on 64-bit hosts, beyond.
+        for bit in 3..usize::BITS {
+            let p = 1_usize << bit;
+            (p - 8..=p + 8).for_each(check);
+        }
+        (u32::MAX as usize - 100_000..=u32::MAX as usize).for_each(check);
+        (usize::MAX - 8..=usize::MAX).for_each(check);
+        // A spread of other values (a fixed LCG).
+        let mut x = 1_u32;
+        for _ in 0..1_000_000 {
+            x = x.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            check(x as usize);
+        }
     }
 }
