@@ -142,6 +142,8 @@ struct Parts {
     persist: Vec<Place>,
     /// Every stored entry (RAM and persistent): what an NMT reset sets back to its default.
     resets: Vec<Place>,
+    /// Record types emitted so far, by shape (sub, field, type of each entry).
+    shapes: Vec<(String, Ident)>,
 }
 
 /// One stored value: its index, where it lives in `Od`, its type and its default.
@@ -158,6 +160,12 @@ struct Place {
     per_mode: bool,
 }
 
+impl Place {
+    fn new(number: u16, place: TokenStream, ty: TokenStream, default: TokenStream, per_mode: bool) -> Place {
+        Place { number, index: crate::hex(number.into(), 4), place, ty, default, per_mode }
+    }
+}
+
 impl Parts {
     fn place(&mut self, e: &Entry, number: u16, place: TokenStream, ty: TokenStream, defaults: ModeDefaults) {
         let distinct: std::collections::BTreeSet<String> = defaults.iter().map(|(_, t)| t.to_string()).collect();
@@ -171,7 +179,7 @@ impl Parts {
                 quote!(match self.mode { #(#arms,)* #[allow(unreachable_patterns)] _ => Default::default() })
             }
         };
-        let p = Place { number, index: crate::hex(number.into(), 4), place, ty, default, per_mode };
+        let p = Place::new(number, place, ty, default, per_mode);
         if persistent(e) {
             self.persist.push(p.clone());
         }
@@ -209,33 +217,72 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
             if let Some(e) = kept.iter().find(|e| e.sub == 0) {
                 parts.place(e, slot.index, quote!(self.#field.sub0), quote!(u8), defaults(e.sub));
             }
-            for e in &items {
-                let i = crate::dec(u64::from(e.sub) - 1);
-                parts.place(e, slot.index, quote!(self.#field.items[#i]), ty.clone(), defaults(e.sub));
-            }
             let count = crate::dec(n as u64);
+            let item_defaults: Vec<ModeDefaults> = items.iter().map(|e| defaults(e.sub)).collect();
+            let texts: std::collections::BTreeSet<String> = item_defaults.iter().flatten().map(|(_, t)| t.to_string()).collect();
+            match item_defaults.first().and_then(|d| d.first()) {
+                // Every item has one default in every mode: one array store resets them all
+                // (a fill, not one store per item); the store still saves item by item.
+                Some((_, default)) if texts.len() == 1 && items.len() == n => {
+                    for e in items.iter().filter(|e| persistent(e)) {
+                        let i = crate::dec(u64::from(e.sub) - 1);
+                        parts.persist.push(Place::new(slot.index, quote!(self.#field.items[#i]), ty.clone(), default.clone(), false));
+                    }
+                    parts.resets.push(Place::new(slot.index, quote!(self.#field.items), quote!([#ty; #count]), quote!([#default; #count]), false));
+                }
+                _ => {
+                    for (e, d) in items.iter().zip(item_defaults) {
+                        let i = crate::dec(u64::from(e.sub) - 1);
+                        parts.place(e, slot.index, quote!(self.#field.items[#i]), ty.clone(), d);
+                    }
+                }
+            }
             parts.fields.push(quote!(#[doc = #doc] pub #field: #stack::value::Array<#ty, #count>));
             parts.names.push(field.clone());
-            parts.field_arms.push(quote!((#number, 0) => &mut self.#field.sub0));
-            parts.field_arms.push(quote!((#number, s) => self.#field.items.get_mut(usize::from(s).wrapping_sub(1))?));
+            parts.field_arms.push(quote!((#number, s) => self.#field.sub(s)?));
         }
         ObjectKind::Record => {
             let name = camel(&o.ident);
             let mut sub_fields = Vec::new();
+            let mut sub_arms = Vec::new();
+            let mut shape = String::new();
             for e in &kept {
                 let f = id(&e.ident);
                 let sub = crate::dec(e.sub.into());
                 let ty = rust_type(e, stack);
                 parts.place(e, slot.index, quote!(self.#field.#f), ty.clone(), defaults(e.sub));
                 let sdoc = format!(" Sub {}: {}", e.sub, e.name);
+                shape.push_str(&format!("{}:{f}:{ty};", e.sub));
                 sub_fields.push(quote!(#[doc = #sdoc] pub #f: #ty));
-                parts.field_arms.push(quote!((#number, #sub) => &mut self.#field.#f));
+                sub_arms.push(quote!(#sub => &mut self.#f));
             }
-            parts.structs.push(quote! {
-                #[doc = #doc]
-                #[derive(Debug, Clone, PartialEq, Default)]
-                pub struct #name { #(#sub_fields),* }
-            });
+            // Records of one shape (the PDO parameter records) share one type and one
+            // sub-index dispatch; the later ones are aliases of the first.
+            match parts.shapes.iter().find(|(s, _)| *s == shape) {
+                Some((_, first)) => {
+                    let alias = format!("{doc} (the same record as [`{first}`])");
+                    parts.structs.push(quote!(#[doc = #alias] pub type #name = #first;));
+                }
+                None => {
+                    parts.shapes.push((shape, name.clone()));
+                    parts.structs.push(quote! {
+                        #[doc = #doc]
+                        #[derive(Debug, Clone, PartialEq, Default)]
+                        pub struct #name { #(#sub_fields),* }
+
+                        impl #name {
+                            /// The field of sub-index `sub`.
+                            pub fn sub(&mut self, sub: u8) -> Option<&mut dyn #stack::value::OdValue> {
+                                Some(match sub {
+                                    #(#sub_arms,)*
+                                    _ => return None,
+                                })
+                            }
+                        }
+                    });
+                }
+            }
+            parts.field_arms.push(quote!((#number, s) => self.#field.sub(s)?));
             parts.fields.push(quote!(#[doc = #doc] pub #field: #name));
             parts.names.push(field.clone());
         }
@@ -298,12 +345,20 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let block_transfer = d.identity.sdo_block_transfer;
     let has = |index: u16| d.objects.iter().any(|o| o.index == index);
     let (history, sync_cycle, consumer) = (has(0x1003), has(0x1006), has(0x1016));
-    let mut parts = Parts { structs: Vec::new(), fields: Vec::new(), names: Vec::new(), field_arms: Vec::new(), persist: Vec::new(), resets: Vec::new() };
+    let mut parts = Parts {
+        structs: Vec::new(),
+        fields: Vec::new(),
+        names: Vec::new(),
+        field_arms: Vec::new(),
+        persist: Vec::new(),
+        resets: Vec::new(),
+        shapes: Vec::new(),
+    };
     for slot in slots(d) {
         let defaults = |sub| mode_defaults(d, modes, slot.index, sub, stack);
         slot_parts(&slot, stack, &mut parts, &defaults);
     }
-    let Parts { structs, fields, names, field_arms, persist, resets } = parts;
+    let Parts { structs, fields, names, field_arms, persist, resets, .. } = parts;
     let (p_index, places): (Vec<&TokenStream>, Vec<&TokenStream>) = persist.iter().map(|p| (&p.index, &p.place)).unzip();
     let types: Vec<&TokenStream> = persist.iter().map(|p| &p.ty).collect();
     let reset_groups = reset_groups(&resets);

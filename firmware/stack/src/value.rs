@@ -209,6 +209,17 @@ impl<T: Default + Copy, const N: usize> Default for Array<T, N> {
     }
 }
 
+impl<T: OdValue, const N: usize> Array<T, N> {
+    /// The field of sub-index `sub`: 0 the count, 1..=N the items (the generated dispatch
+    /// routes every sub-index of an array here, one arm per array).
+    pub fn sub(&mut self, sub: u8) -> Option<&mut dyn OdValue> {
+        match sub.checked_sub(1) {
+            None => Some(&mut self.sub0),
+            Some(i) => self.items.get_mut(usize::from(i)).map(|v| v as &mut dyn OdValue),
+        }
+    }
+}
+
 /// A field's fixed-size image in the 1010h/1011h store: what `save` writes, `load` reads.
 pub trait Persist {
     /// Bytes of the image.
