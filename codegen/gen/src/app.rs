@@ -134,10 +134,30 @@ pub fn app_module(d: &Device, options: &Options) -> TokenStream {
                 #[doc = #doc]
                 fn #read(&mut self, #n_param #sub_param) -> Result<#ty, #stack::od::SdoAbort>;
             });
+            // A value as wide as its Rust type (all but BOOLEAN and the 24/40/48/56-bit
+            // types) is its little-endian bytes: no generic conversion on the RPDO, TPDO and
+            // serial paths.
+            let exact = entries
+                .iter()
+                .all(|e| e.data_type.bits().is_some_and(|b| matches!(b, 8 | 16 | 32 | 64)) && e.data_type != coforge_spec::types::DataType::Boolean);
+            let (to_bytes, from_bytes) = if exact {
+                (
+                    quote!(#stack::od::read_slice(&value.to_le_bytes(), offset, buf)),
+                    quote!(let value = #ty::from_le_bytes(data.try_into().map_err(|_| #stack::od::SdoAbort::LengthMismatch)?);),
+                )
+            } else {
+                (
+                    quote!(#stack::value::OdValue::read(&value, entry, offset, buf)),
+                    quote! {
+                        let mut value: #ty = Default::default();
+                        #stack::value::OdValue::write(&mut value, entry, data)?;
+                    },
+                )
+            };
             read_arms.push(quote! {
                 #pattern => {
                     let value = self.0.#read(#n_arg #sub_arg)?;
-                    #stack::value::OdValue::read(&value, entry, offset, buf)
+                    #to_bytes
                 }
             });
             if writable {
@@ -147,8 +167,7 @@ pub fn app_module(d: &Device, options: &Options) -> TokenStream {
                 });
                 write_arms.push(quote! {
                     #pattern => {
-                        let mut value: #ty = Default::default();
-                        #stack::value::OdValue::write(&mut value, entry, data)?;
+                        #from_bytes
                         self.0.#write(#n_arg #sub_arg value)
                     }
                 });

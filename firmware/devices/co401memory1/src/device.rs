@@ -244,19 +244,21 @@ impl<S: Storage, B: Board> Device for Memory1<S, B> {
 impl<S: Storage, B: Board> HostPort for Memory1<S, B> {
     fn on_host_byte(&mut self, byte: u8, now_us: u64) {
         let now_ms = self.host_clock.at(now_us);
-        let mut data = [0_u8; coforge_link::nibble::MAX_DATA];
-        let (code, len) = match self.host.push(byte, now_ms) {
+        // The frame is copied out of the decoder (the answer needs the whole module), and
+        // only once it is complete.
+        let (code, data, len) = match self.host.push(byte, now_ms) {
             None => return,
             Some(Err(_)) => {
                 self.host_rejects = self.host_rejects.wrapping_add(1);
                 return;
             }
             Some(Ok(frame)) => {
+                let mut data = [0_u8; coforge_link::nibble::MAX_DATA];
                 let n = frame.data.len().min(data.len());
                 if let (Some(dst), Some(src)) = (data.get_mut(..n), frame.data.get(..n)) {
                     dst.copy_from_slice(src);
                 }
-                (frame.code, n)
+                (frame.code, data, n)
             }
         };
         let frame = coforge_link::Frame { code, length_code: None, network: None, data: data.get(..len).unwrap_or(&[]) };
