@@ -71,8 +71,8 @@ proptest! {
             match input {
                 Input::Serial { byte, gap_ms } => {
                     now_ms += gap_ms;
-                    dev.on_host_byte(byte, u64::from(now_ms) * 1000);
-                    let n = dev.host_output(u64::from(now_ms) * 1000, &mut out);
+                    dev.on_host_byte(byte, u64::from(now_ms));
+                    let n = dev.host_output(u64::from(now_ms), &mut out);
                     prop_assert!(n <= out.len());
                 }
                 Input::Can { id, rtr, data } => {

@@ -29,32 +29,6 @@ pub fn elapsed(earlier: Millis, later: Millis) -> u32 {
     later.wrapping_sub(earlier)
 }
 
-/// The millisecond clock of a framing, kept from the microsecond times the device contract
-/// hands over, without a 64-bit division (one costs a Cortex-M0 about 1 KiB of flash): it
-/// counts the whole milliseconds between calls and carries the rest.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct MillisClock {
-    last_us: u64,
-    ms: Millis,
-    carry_us: u32,
-}
-
-impl MillisClock {
-    /// The clock at `now_us` (times never run backwards; an earlier time reads as no time).
-    pub fn at(&mut self, now_us: u64) -> Millis {
-        // Nothing to do for bytes that arrive in the same pass of a main loop.
-        if now_us > self.last_us {
-            // A step beyond 35 minutes only needs to read as long: the framings compare
-            // pauses of milliseconds.
-            let step = (now_us - self.last_us).min(u64::from(u32::MAX / 2)) as u32 + self.carry_us;
-            self.last_us = now_us;
-            self.ms = self.ms.wrapping_add(step / 1000);
-            self.carry_us = step % 1000;
-        }
-        self.ms
-    }
-}
-
 /// Bytes waiting for the host: answers are encoded into it and handed out whenever the
 /// runtime asks, so a device can also answer late or unasked.
 #[derive(Debug, Clone)]
@@ -195,25 +169,8 @@ type Decoded = core::result::Result<(u8, Option<u8>, std::vec::Vec<u8>), FrameEr
 extern crate std;
 
 #[cfg(test)]
-mod clock_tests {
+mod outbox_tests {
     use super::*;
-
-    #[test]
-    fn millis_follow_microseconds_without_drift() {
-        let mut c = MillisClock::default();
-        assert_eq!(c.at(999), 0);
-        assert_eq!(c.at(1_000), 1);
-        assert_eq!(c.at(2_500), 2);
-        assert_eq!(c.at(3_499), 3, "the carried 500 us count");
-        // 10 000 steps of 1.7 ms read as 17 000 ms: nothing lost to rounding.
-        let mut now = 3_499;
-        for _ in 0..10_000 {
-            now += 1_700;
-        }
-        assert_eq!(c.at(now), 3 + 17_000);
-        assert_eq!(c.at(now - 5_000), 3 + 17_000, "an earlier time reads as no time");
-        assert!(elapsed(17_003, c.at(now + 5_000_000_000)) >= 1_000_000, "an 83-minute gap reads as long");
-    }
 
     #[test]
     fn the_outbox_keeps_frames_whole_and_in_order() {

@@ -119,7 +119,7 @@ fn run(mut nodes: Vec<Box<dyn SimDevice>>, ports: Vec<Port>, stop: &AtomicBool, 
                 }
                 Input::HostByte { node, byte, at } => {
                     if let Some(port) = nodes.get_mut(node).and_then(|n| n.host_port()) {
-                        port.on_host_byte(byte, us_at(at));
+                        port.on_host_byte(byte, us_at(at) / 1000);
                     }
                 }
                 Input::Control { node, command, reply } => {
@@ -142,7 +142,7 @@ fn run(mut nodes: Vec<Box<dyn SimDevice>>, ports: Vec<Port>, stop: &AtomicBool, 
             // Answers, late answers and unsolicited output alike; without a host they are lost,
             // as on an unconnected UART.
             let mut out = [0_u8; 64];
-            while let Some(n) = node.host_port().map(|p| p.host_output(now_us(), &mut out)).filter(|&n| n > 0) {
+            while let Some(n) = node.host_port().map(|p| p.host_output(now_us() / 1000, &mut out)).filter(|&n| n > 0) {
                 busy = true;
                 if host.as_ref().is_some_and(|h| h.send(out.get(..n).unwrap_or(&[]).to_vec()).is_err()) {
                     *host = None;

@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 /// Unasked 0xAA every 100 ms; every byte from the host echoed 50 ms late.
 struct Beacon {
     node: co401gw1::Node<RamApp, NoStore>,
-    next_beacon_us: u64,
+    next_beacon_ms: u64,
     echo: Option<(u8, u64)>,
 }
 
@@ -52,19 +52,19 @@ impl Device for Beacon {
 }
 
 impl HostPort for Beacon {
-    fn on_host_byte(&mut self, byte: u8, now_us: u64) {
-        self.echo = Some((byte, now_us + 50_000));
+    fn on_host_byte(&mut self, byte: u8, now_ms: u64) {
+        self.echo = Some((byte, now_ms + 50));
     }
-    fn host_output(&mut self, now_us: u64, out: &mut [u8]) -> usize {
+    fn host_output(&mut self, now_ms: u64, out: &mut [u8]) -> usize {
         if let Some((byte, due)) = self.echo
-            && now_us >= due
+            && now_ms >= due
         {
             self.echo = None;
             out[0] = byte;
             return 1;
         }
-        if now_us >= self.next_beacon_us {
-            self.next_beacon_us = now_us + 100_000;
+        if now_ms >= self.next_beacon_ms {
+            self.next_beacon_ms = now_ms + 100;
             out[0] = 0xAA;
             return 1;
         }
@@ -78,7 +78,7 @@ impl Console for Beacon {}
 fn unasked_and_late_output_reaches_the_client() {
     let od = co401gw1::Od::new(co401gw1::Mode::ALL[0], 5, RamApp::default());
     let node = coforge_stack::node::Node::new(od, NoStore, co401gw1::node_config(5));
-    let beacon = Beacon { node, next_beacon_us: 0, echo: None };
+    let beacon = Beacon { node, next_beacon_ms: 0, echo: None };
     let hub = Hub::bind("127.0.0.1:0").unwrap();
     let running = coforge_sim::runner::spawn(&hub, vec![Box::new(beacon)]);
     let port = coforge_sim::serial::serve("127.0.0.1:0", 0, running.inputs()).unwrap();

@@ -7,8 +7,9 @@
 //!    │                                           │
 //!    └──on_host_byte(byte, t)──▶ HostPort ──host_output(t)──▶ bytes to the host, at any time
 //! ```
-//! All times are microseconds from an arbitrary epoch; a device never reads a clock itself.
-//! The serial host port is byte-oriented both ways: a device answers late, or unasked (a
+//! Times are microseconds from an arbitrary epoch, except on the serial host port, whose
+//! framings time gaps and pauses in milliseconds (so a byte costs no 64-bit division); a
+//! device never reads a clock itself. The serial host port is byte-oriented both ways: a device answers late, or unasked (a
 //! boot-up frame every 250 ms, an indication), so output is polled, not returned per byte.
 
 use crate::emcy::EmcyDefault;
@@ -52,12 +53,12 @@ pub trait Device {
 
 /// A device's serial host interface, as a byte stream each way.
 pub trait HostPort {
-    /// A byte from the host, received at `now_us` (framings resynchronise on pauses).
-    fn on_host_byte(&mut self, byte: u8, now_us: u64);
+    /// A byte from the host, received at `now_ms` (framings resynchronise on pauses).
+    fn on_host_byte(&mut self, byte: u8, now_ms: u64);
 
-    /// Copies bytes waiting for the host at `now_us` into `out` and returns how many: answers,
+    /// Copies bytes waiting for the host at `now_ms` into `out` and returns how many: answers,
     /// late answers and unsolicited frames alike. 0 when nothing waits.
-    fn host_output(&mut self, now_us: u64, out: &mut [u8]) -> usize;
+    fn host_output(&mut self, now_ms: u64, out: &mut [u8]) -> usize;
 }
 
 /// The node underneath a device, for runtimes and host tools (object-safe, so a runtime can

@@ -16,15 +16,16 @@ pub fn serve<D: Device>(device: &mut D) -> ! {
     let mut lines = slcan::Decoder::new();
     let mut line = [0_u8; slcan::MAX_FRAME_LINE];
     loop {
-        let now_us = clock::millis() * 1000;
+        let now_ms = clock::millis();
+        let now_us = now_ms * 1000;
         if let Some(port) = device.host_port() {
             while let Some(byte) = host.read() {
-                port.on_host_byte(byte, now_us);
+                port.on_host_byte(byte, now_ms);
             }
             // Polled on every pass, not only after a byte: answers may come late or unasked.
             // One byte at a time: the UART sends no faster anyway.
             let mut byte = [0];
-            while port.host_output(now_us, &mut byte) == 1 {
+            while port.host_output(now_ms, &mut byte) == 1 {
                 host.write(&byte);
             }
         }

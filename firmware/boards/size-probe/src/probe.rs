@@ -29,18 +29,19 @@ pub fn run_with_codec<D: Device, C: SerialCodec>(device: &'static mut D) -> ! {
 
 fn drive<D: Device>(device: &'static mut D, mut codec: impl FnMut()) -> ! {
     device.start(0);
-    let mut now = 0_u64;
+    let (mut now, mut now_ms) = (0_u64, 0_u64);
     let mut out = [0_u8; 16];
     loop {
         now += 1000;
+        now_ms += 1;
         let frame = CanFrame { id: black_box(0x605), rtr: black_box(false), dlc: 8, data: black_box([0x40, 0x18, 0x10, 1, 0, 0, 0, 0]) };
         device.on_frame(&frame, now);
         while let Some(sent) = device.poll(now) {
             black_box(sent);
         }
         if let Some(port) = device.host_port() {
-            port.on_host_byte(black_box(0x33), now);
-            let n = port.host_output(now, &mut out);
+            port.on_host_byte(black_box(0x33), now_ms);
+            let n = port.host_output(now_ms, &mut out);
             black_box(out.get(..n));
         }
         codec();

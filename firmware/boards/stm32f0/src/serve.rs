@@ -37,7 +37,7 @@ pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut leds
         if let Some(port) = device.host_port() {
             loop {
                 match host.read() {
-                    Ok(byte) => port.on_host_byte(byte, now_us),
+                    Ok(byte) => port.on_host_byte(byte, now_ms),
                     // Framing, noise, overrun: the flag is cleared, the byte (if any) comes next.
                     Err(nb::Error::Other(_)) => {}
                     Err(nb::Error::WouldBlock) => break,
@@ -46,7 +46,7 @@ pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut leds
             // Polled on every pass, not only after a byte: answers may come late or unasked.
             // One byte at a time: the UART sends no faster anyway.
             let mut byte = [0];
-            while port.host_output(now_us, &mut byte) == 1 {
+            while port.host_output(now_ms, &mut byte) == 1 {
                 let _ = nb::block!(host.write(byte[0]));
             }
         }

@@ -8,7 +8,7 @@ use crate::memory::MemoryApp;
 use crate::monitor::{Monitor, monitored_id};
 use crate::supply::Supply;
 use crate::{Mode, Node, Od, emcy, node_config, serial};
-use coforge_link::{Deframer, MillisClock, Outbox};
+use coforge_link::{Deframer, Millis, Outbox};
 use coforge_stack::device::{Assemble, AssembleError, Device, HostPort, MemoryRequest, NodeAccess};
 use coforge_stack::frame::CanFrame;
 use coforge_stack::leds::Leds;
@@ -33,7 +33,6 @@ pub struct Memory1<S, B> {
     pub(crate) board: B,
     config: Config,
     host: serial::Decoder,
-    host_clock: MillisClock,
     pub(crate) host_out: Outbox<HOST_OUT>,
     pub(crate) monitor: Monitor,
     pub(crate) supply: Supply,
@@ -62,7 +61,6 @@ impl<S: Storage, B: Board> Memory1<S, B> {
             board,
             config,
             host: serial::decoder(),
-            host_clock: MillisClock::default(),
             host_out: Outbox::default(),
             monitor: Monitor::default(),
             supply: Supply::Normal,
@@ -242,8 +240,9 @@ impl<S: Storage, B: Board> Device for Memory1<S, B> {
 
 /// The RS232 host interface: one answer per command, queued until the runtime sends it.
 impl<S: Storage, B: Board> HostPort for Memory1<S, B> {
-    fn on_host_byte(&mut self, byte: u8, now_us: u64) {
-        let now_ms = self.host_clock.at(now_us);
+    fn on_host_byte(&mut self, byte: u8, now_ms: u64) {
+        // The framing compares wrapping differences of a 32-bit millisecond clock.
+        let now_ms = now_ms as Millis;
         // The frame is copied out of the decoder (the answer needs the whole module), and
         // only once it is complete.
         let (code, data, len) = match self.host.push(byte, now_ms) {
@@ -267,7 +266,7 @@ impl<S: Storage, B: Board> HostPort for Memory1<S, B> {
         self.update(false);
     }
 
-    fn host_output(&mut self, _now_us: u64, out: &mut [u8]) -> usize {
+    fn host_output(&mut self, _now_ms: u64, out: &mut [u8]) -> usize {
         self.host_out.take(out)
     }
 }

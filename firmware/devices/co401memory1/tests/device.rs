@@ -93,8 +93,8 @@ impl Rig {
         for &b in bytes {
             self.now_us += 1_000;
             let mut out = [0; 16];
-            self.dev.on_host_byte(b, self.now_us);
-            let n = self.dev.host_output(self.now_us, &mut out);
+            self.dev.on_host_byte(b, self.now_us / 1000);
+            let n = self.dev.host_output(self.now_us / 1000, &mut out);
             answer.extend_from_slice(&out[..n]);
         }
         self.run(1_000);

@@ -276,9 +276,9 @@ fn main() -> ! {
     let mut out = [0_u8; 16];
     let n = measure(7, || {
         for &byte in &command {
-            device.on_host_byte(byte, NOW_US);
+            device.on_host_byte(byte, NOW_US / 1000);
         }
-        device.host_output(NOW_US, &mut out)
+        device.host_output(NOW_US / 1000, &mut out)
     });
     if out.get(..n) != Some(&[0x32, 0x01, 0x23][..]) {
         hprintln!("bench: serial answer {:02x?}", out.get(..n).unwrap_or(&[]));
