@@ -38,6 +38,12 @@ macro_rules! integer_value {
                 read_slice(bytes.get(..usize::from(entry.size)).unwrap_or(&bytes), offset, buf)
             }
             fn write(&mut self, entry: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
+                // A full-width value (all but the 24/40/48/56-bit types) is its bytes: the
+                // RPDO and SDO paths take this branch, without the generic decoder's loop.
+                if let Ok(bytes) = data.try_into() {
+                    *self = <$t>::from_le_bytes(bytes);
+                    return Ok(());
+                }
                 // In range by `int_bits`: the cast keeps the value.
                 *self = int_bits(entry, data, size_of::<$t>(), <$t>::MIN != 0)? as $t;
                 Ok(())
