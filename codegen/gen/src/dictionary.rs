@@ -239,7 +239,7 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
             }
             parts.fields.push(quote!(#[doc = #doc] pub #field: #stack::value::Array<#ty, #count>));
             parts.names.push(field.clone());
-            parts.field_arms.push(quote!((#number, s) => self.#field.sub(s)?));
+            parts.field_arms.push(quote!((#number, s) => self.#field.sub(s)));
         }
         ObjectKind::Record => {
             let name = camel(&o.ident);
@@ -272,6 +272,7 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
 
                         impl #name {
                             /// The field of sub-index `sub`.
+                            #[inline]
                             pub fn sub(&mut self, sub: u8) -> Option<&mut dyn #stack::value::OdValue> {
                                 Some(match sub {
                                     #(#sub_arms,)*
@@ -282,7 +283,7 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
                     });
                 }
             }
-            parts.field_arms.push(quote!((#number, s) => self.#field.sub(s)?));
+            parts.field_arms.push(quote!((#number, s) => self.#field.sub(s)));
             parts.fields.push(quote!(#[doc = #doc] pub #field: #name));
             parts.names.push(field.clone());
         }
@@ -306,7 +307,7 @@ fn plain_field(
     parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
     parts.names.push(field.clone());
     // The caller has found `sub` in this entry's run, so a single field needs no sub test.
-    parts.field_arms.push(quote!((#number, _) => &mut self.#field));
+    parts.field_arms.push(quote!((#number, _) => Some(&mut self.#field)));
 }
 
 /// The class of an index: resets test one index per run of places in the same class, since
@@ -489,11 +490,10 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
 
             #[allow(unreachable_patterns)]
             fn field(&mut self, info: &#stack::od::EntryInfo, sub: u8) -> Option<&mut dyn #stack::value::OdValue> {
-                let field: &mut dyn #stack::value::OdValue = match (info.object, sub) {
+                match (info.object, sub) {
                     #(#field_arms,)*
-                    _ => return None,
-                };
-                Some(field)
+                    _ => None,
+                }
             }
 
             fn app(&mut self) -> &mut A {

@@ -218,6 +218,7 @@ impl<T: Default + Copy, const N: usize> Default for Array<T, N> {
 impl<T: OdValue, const N: usize> Array<T, N> {
     /// The field of sub-index `sub`: 0 the count, 1..=N the items (the generated dispatch
     /// routes every sub-index of an array here, one arm per array).
+    #[inline]
     pub fn sub(&mut self, sub: u8) -> Option<&mut dyn OdValue> {
         match sub.checked_sub(1) {
             None => Some(&mut self.sub0),
