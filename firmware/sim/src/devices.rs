@@ -113,9 +113,10 @@ fn build<T: Assemble<Eeprom> + Console + Send + 'static>(
     node_id: u8,
     store: &StoreAt,
 ) -> Result<Box<dyn SimDevice>, String> {
+    let bad_node_id = || format!("node-ID {node_id} is outside 1..=127");
     // Checked first, so that no file is created for a device that cannot run.
     if !(1..=127).contains(&node_id) {
-        return Err(format!("node-ID {node_id} is outside 1..=127"));
+        return Err(bad_node_id());
     }
     let mut file_error = None;
     let mut memory = |request| eeprom(store, request).map_err(|e| file_error = Some(e)).ok();
@@ -126,7 +127,7 @@ fn build<T: Assemble<Eeprom> + Console + Send + 'static>(
             T::mode_names(&mut |m| known.push(m));
             Err(format!("{name} has no mode `{}`; its modes are: {}", mode.unwrap_or_default(), known.join(", ")))
         }
-        Err(AssembleError::NodeId) => Err(format!("node-ID {node_id} is outside 1..=127")),
+        Err(AssembleError::NodeId) => Err(bad_node_id()),
         Err(AssembleError::NoMemory(what)) => Err(file_error.unwrap_or_else(|| format!("{name}: no {what} memory"))),
         Err(AssembleError::Config(why)) => Err(format!("{name}: {why}")),
     }

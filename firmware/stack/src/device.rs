@@ -208,6 +208,21 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> NodeAcces
     }
 }
 
+/// What every device checks first when it is assembled: the mode a runtime names exists in
+/// dictionary `D`, and the node-ID is one CANopen allows.
+pub fn assembly_mode<D: NodeDictionary>(mode: Option<&str>, node_id: u8) -> Result<D::Mode, AssembleError> {
+    let mode = mode_named::<D>(mode).map_err(|_| AssembleError::UnknownMode)?;
+    if !(1..=127).contains(&node_id) {
+        return Err(AssembleError::NodeId);
+    }
+    Ok(mode)
+}
+
+/// Calls `f` with the spec name of each mode of dictionary `D` (`Assemble::mode_names`).
+pub fn mode_names<D: NodeDictionary>(f: &mut dyn FnMut(&'static str)) {
+    D::MODES.iter().for_each(|&m| f(D::mode_name(m)));
+}
+
 /// A plain generated node keeps its parameters (1010h/1011h) in a block store on the one
 /// memory it asks for.
 impl<D, M, const N: usize, const P: usize> Assemble<M> for Node<D, crate::store::BlockStore<M>, N, P>
@@ -217,14 +232,11 @@ where
     M: embedded_storage::Storage,
 {
     fn mode_names(f: &mut dyn FnMut(&'static str)) {
-        D::MODES.iter().for_each(|&m| f(D::mode_name(m)));
+        mode_names::<D>(f);
     }
 
     fn assemble(mode: Option<&str>, node_id: u8, memory: &mut dyn FnMut(MemoryRequest) -> Option<M>) -> Result<Self, AssembleError> {
-        let mode = mode_named::<D>(mode).map_err(|_| AssembleError::UnknownMode)?;
-        if !(1..=127).contains(&node_id) {
-            return Err(AssembleError::NodeId);
-        }
+        let mode = assembly_mode::<D>(mode, node_id)?;
         let request = MemoryRequest { name: "parameters", capacity: crate::store::BlockStore::<M>::capacity_for(D::PERSISTENT_SIZE) };
         let storage = memory(request).ok_or(AssembleError::NoMemory(request.name))?;
         Ok(Node::of_dictionary(mode, node_id, D::App::default(), crate::store::BlockStore::new(storage, 0)))

@@ -9,7 +9,7 @@ use crate::monitor::{Monitor, monitored_id};
 use crate::supply::Supply;
 use crate::{Mode, Node, Od, emcy, node_config, serial};
 use coforge_link::{Deframer, Millis, Outbox};
-use coforge_stack::device::{Assemble, AssembleError, Device, HostPort, MemoryRequest, NodeAccess};
+use coforge_stack::device::{Assemble, AssembleError, Device, HostPort, MemoryRequest, NodeAccess, assembly_mode, mode_names};
 use coforge_stack::frame::CanFrame;
 use coforge_stack::leds::Leds;
 use coforge_stack::nmt::NmtState;
@@ -275,16 +275,12 @@ impl<S: Storage, B: Board> HostPort for Memory1<S, B> {
 /// runtime (the simulator's EEPROM images).
 impl<S: Storage> Assemble<S> for Memory1<S, FixedBoard> {
     fn mode_names(f: &mut dyn FnMut(&'static str)) {
-        f(Mode::Default.name());
+        mode_names::<Od<Typed<MemoryApp<S>>>>(f);
     }
 
     fn assemble(mode: Option<&str>, node_id: u8, memory: &mut dyn FnMut(MemoryRequest) -> Option<S>) -> Result<Self, AssembleError> {
-        if mode.is_some_and(|m| m != Mode::Default.name()) {
-            return Err(AssembleError::UnknownMode);
-        }
-        if !(1..=127).contains(&node_id) {
-            return Err(AssembleError::NodeId);
-        }
+        // The module has one mode; its node-ID comes from the pins the board sets.
+        assembly_mode::<Od<Typed<MemoryApp<S>>>>(mode, node_id)?;
         let mut bank = |name| memory(MemoryRequest { name, capacity: BANK_SIZE }).ok_or(AssembleError::NoMemory(name));
         let banks = [bank("bank1")?, bank("bank2")?];
         Memory1::new(banks, FixedBoard::new(node_id)).map_err(|_| AssembleError::Config("reserved configuration pins"))
