@@ -27,6 +27,17 @@ impl CanFrame {
         Some(CanFrame { id, rtr: false, dlc: data.len() as u8, data: bytes })
     }
 
+    /// A data frame of the first `len` bytes of `data` (the rest are cleared); `None` if `id`
+    /// needs more than 11 bits or `len` is over 8. A fixed-size copy: what PDOs are built from.
+    pub fn from_payload(id: u16, data: [u8; 8], len: u8) -> Option<CanFrame> {
+        if id > 0x7FF || len > 8 {
+            return None;
+        }
+        // The low `len` bytes of the little-endian word; a shift by 64 (len 0) keeps none.
+        let keep = u64::MAX.checked_shr(8 * u32::from(8 - len)).unwrap_or(0);
+        Some(CanFrame { id, rtr: false, dlc: len, data: (u64::from_le_bytes(data) & keep).to_le_bytes() })
+    }
+
     /// A remote frame requesting `dlc` bytes.
     pub fn remote(id: u16, dlc: u8) -> Option<CanFrame> {
         (id <= 0x7FF && dlc <= 8).then_some(CanFrame { id, rtr: true, dlc, data: [0; 8] })
@@ -85,6 +96,17 @@ impl embedded_can::Frame for CanFrame {
 mod tests {
     use super::*;
     use embedded_can::Frame as _;
+
+    #[test]
+    fn a_payload_frame_is_the_data_frame_of_its_prefix() {
+        let bytes = [1, 2, 3, 4, 5, 6, 7, 8];
+        for len in 0..=8_u8 {
+            let f = CanFrame::from_payload(0x181, bytes, len).unwrap();
+            assert_eq!(Some(f), CanFrame::data(0x181, &bytes[..usize::from(len)]), "len {len}");
+        }
+        assert_eq!(CanFrame::from_payload(0x181, bytes, 9), None);
+        assert_eq!(CanFrame::from_payload(0x800, bytes, 1), None);
+    }
 
     #[test]
     fn frames_keep_only_what_a_can_frame_can_carry() {

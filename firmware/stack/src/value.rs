@@ -34,6 +34,15 @@ macro_rules! integer_value {
         impl OdValue for $t {
             fn read(&self, entry: &EntryInfo, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
                 let bytes = self.to_le_bytes();
+                // The whole value into a buffer that holds it (every PDO and expedited read):
+                // a fixed-size copy, not a call to `memcpy`.
+                if offset == 0
+                    && usize::from(entry.size) == bytes.len()
+                    && let Some(dst) = buf.get_mut(..bytes.len())
+                {
+                    dst.copy_from_slice(&bytes);
+                    return Ok(ReadLen { copied: bytes.len(), total: bytes.len() });
+                }
                 // 24/40/48/56-bit types live in the next wider Rust integer.
                 read_slice(bytes.get(..usize::from(entry.size)).unwrap_or(&bytes), offset, buf)
             }

@@ -355,7 +355,16 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     }
 
     fn send(&mut self, id: u16, data: &[u8]) {
-        let Some(frame) = CanFrame::data(id, data) else { return };
+        self.queue(CanFrame::data(id, data));
+    }
+
+    /// Sends the first `len` bytes of `data` (a packed PDO).
+    fn send_payload(&mut self, id: u16, data: [u8; 8], len: u8) {
+        self.queue(CanFrame::from_payload(id, data, len));
+    }
+
+    fn queue(&mut self, frame: Option<CanFrame>) {
+        let Some(frame) = frame else { return };
         if self.tx.push_back(frame).is_err() {
             self.tx_overflows = self.tx_overflows.saturating_add(1);
         }

@@ -72,12 +72,8 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
                 continue;
             }
             if t.comm.transmission_type == 252 {
-                let mapping = t.mapping;
-                let mut buf = [0_u8; 8];
-                if let Ok(n) = mapping.pack(&mut self.od, &mut buf)
-                    && let Some(t) = self.tpdos.get_mut(i)
-                {
-                    t.sampled = Some((buf, n as u8));
+                if let Ok(sample) = t.mapping.pack(&mut self.od) {
+                    t.sampled = Some(sample);
                 }
             } else if t.on_sync(counter) {
                 self.send_tpdo(i, now);
@@ -88,9 +84,8 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     pub(super) fn on_tpdo_rtr(&mut self, i: usize, now_us: u64) {
         let Some(t) = self.tpdos.get(i) else { return };
         if t.comm.transmission_type == 252 {
-            if let Some((buf, n)) = t.sampled {
-                let id = t.comm.id();
-                self.send(id, buf.get(..usize::from(n)).unwrap_or(&[]));
+            if let Some((data, len)) = t.sampled {
+                self.send_payload(t.comm.id(), data, len);
             }
         } else {
             self.send_tpdo(i, now_us);
@@ -98,14 +93,12 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     }
 
     pub(super) fn send_tpdo(&mut self, i: usize, now_us: u64) {
-        let Some(t) = self.tpdos.get(i) else { return };
-        let (mapping, id) = (t.mapping, t.comm.id());
-        let mut buf = [0_u8; 8];
-        if let Ok(n) = mapping.pack(&mut self.od, &mut buf) {
-            self.send(id, buf.get(..n).unwrap_or(&[]));
-        }
-        if let Some(t) = self.tpdos.get_mut(i) {
-            t.sent(now_us);
+        let Some(t) = self.tpdos.get_mut(i) else { return };
+        let packed = t.mapping.pack(&mut self.od);
+        t.sent(now_us);
+        let id = t.comm.id();
+        if let Ok((data, len)) = packed {
+            self.send_payload(id, data, len);
         }
     }
 

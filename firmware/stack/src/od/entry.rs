@@ -224,11 +224,16 @@ impl EntryInfo {
 
     /// Whether `data` fits this entry: length and value, whoever writes it (`limits`: the
     /// dictionary's limits table).
+    #[inline]
     pub fn check_data(&self, data: &[u8], limits: &'static [Limits]) -> Result<(), SdoAbort> {
-        // The common case first: full length, no limits, not a BOOLEAN.
+        // The common case inline (every RPDO entry): full length, no limits, not a BOOLEAN.
         if data.len() == usize::from(self.size) && self.limits == 0 && self.data_type() != DataType::Boolean {
             return Ok(());
         }
+        self.check_length_and_value(data, limits)
+    }
+
+    fn check_length_and_value(&self, data: &[u8], limits: &'static [Limits]) -> Result<(), SdoAbort> {
         self.check_length(data.len())?;
         self.check_value(data, self.limits_in(limits))
     }

@@ -143,18 +143,21 @@ impl Mapping {
         self.entries().iter().any(|e| e.sub == sub && e.info(entries).is_some_and(|i| e.index(i) == index))
     }
 
-    /// Reads the mapped values into a frame payload; returns its length.
-    pub fn pack(&self, od: &mut impl EntryAccess, out: &mut [u8; 8]) -> Result<usize, SdoAbort> {
+    /// Reads the mapped values into a frame payload: its bytes (zero from the mapped length
+    /// on) and the mapped length.
+    pub fn pack(&self, od: &mut impl EntryAccess) -> Result<([u8; 8], u8), SdoAbort> {
         let entries = od.entries();
+        // Zeroed once here, not per entry: an 8-byte store instead of a fill per entry.
+        let mut out = [0_u8; 8];
         let mut at = 0;
         for e in self.entries() {
             let end = at + usize::from(e.bytes());
             let dst = out.get_mut(at..end).ok_or(SdoAbort::PdoTooLong)?;
-            dst.fill(0);
             let info = e.info(entries).ok_or(SdoAbort::NoObject)?;
             od.read_entry(info, e.index(info), e.sub, 0, dst)?;
             at = end;
         }
-        Ok(at)
+        // At most 8: `out.get_mut(..end)` succeeded.
+        Ok((out, at as u8))
     }
 }
