@@ -245,10 +245,13 @@ fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
             None => quote!(#fixed),
         };
         let pattern = if names.is_empty() { quote!(Self::#v) } else { quote!(Self::#v { #(#names),* }) };
+        // One framing call per command: a fixed length is a constant there, so the copy into
+        // the frame is a few stores, not a `memcpy` call.
         encode_arms.push(quote! {
             #pattern => {
                 #(#writes;)*
-                (#code_expr, #lc, #len)
+                let len = #len;
+                put_frame(#code_expr, #lc, buf.get(..len).unwrap_or(&[]), out)
             }
         });
         let name = &c.name;
@@ -285,8 +288,7 @@ fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
             pub fn encode(&self, out: &mut [u8]) -> Result<usize, ::coforge_link::EncodeError> {
                 // The fields go into one buffer, then through the framing.
                 let mut buf = [0_u8; MAX_DATA];
-                let (code, length_code, len): (u8, Option<u8>, usize) = match self { #(#encode_arms),* };
-                put_frame(code, length_code, buf.get(..len).unwrap_or(&[]), out)
+                match self { #(#encode_arms),* }
             }
 
             /// The command's name in the spec.

@@ -49,6 +49,13 @@ impl NibbleDecoder {
         NibbleDecoder { config, buf: [0; MAX_DATA], code: 0, remaining: None, filled: 0, last: None, truncated: 0 }
     }
 
+    /// The data buffer, whole: the last frame's data is its first `data.len()` bytes. A
+    /// caller that must keep the data past the next `push` copies this fixed-size array,
+    /// which costs a few stores where a copy of `data.len()` bytes is a `memcpy` call.
+    pub const fn buffer(&self) -> &[u8; MAX_DATA] {
+        &self.buf
+    }
+
     fn frame(&self) -> Frame<'_> {
         Frame { code: self.code, length_code: None, network: None, data: self.buf.get(..self.filled).unwrap_or(&[]) }
     }

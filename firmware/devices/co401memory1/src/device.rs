@@ -243,23 +243,17 @@ impl<S: Storage, B: Board> HostPort for Memory1<S, B> {
     fn on_host_byte(&mut self, byte: u8, now_ms: u64) {
         // The framing compares wrapping differences of a 32-bit millisecond clock.
         let now_ms = now_ms as Millis;
-        // The frame is copied out of the decoder (the answer needs the whole module), and
-        // only once it is complete.
-        let (code, data, len) = match self.host.push(byte, now_ms) {
+        let (code, len) = match self.host.push(byte, now_ms) {
             None => return,
             Some(Err(_)) => {
                 self.host_rejects = self.host_rejects.wrapping_add(1);
                 return;
             }
-            Some(Ok(frame)) => {
-                let mut data = [0_u8; coforge_link::nibble::MAX_DATA];
-                let n = frame.data.len().min(data.len());
-                if let (Some(dst), Some(src)) = (data.get_mut(..n), frame.data.get(..n)) {
-                    dst.copy_from_slice(src);
-                }
-                (frame.code, data, n)
-            }
+            Some(Ok(frame)) => (frame.code, frame.data.len()),
         };
+        // The data is copied out of the decoder (the answer needs the whole module), and only
+        // once a frame is complete.
+        let data = *self.host.buffer();
         let frame = coforge_link::Frame { code, length_code: None, network: None, data: data.get(..len).unwrap_or(&[]) };
         self.sample_supply();
         self.answer(&frame);
