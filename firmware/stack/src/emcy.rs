@@ -4,8 +4,9 @@
 //! register bits and an error that clears sends the "error reset" emergency. Frames wait in a
 //! short queue and leave no closer together than the inhibit time.
 
+use crate::ring::Ring;
 pub use coforge_types::EmcyEvent;
-use heapless::{Deque, Vec};
+use heapless::Vec;
 
 /// The NMT reaction a spec emergency asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -78,10 +79,10 @@ pub struct Change {
     pub history: Option<u32>,
 }
 
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct EmcyProducer {
     active: Vec<Active, MAX_ACTIVE>,
-    queue: Deque<[u8; 8], QUEUE>,
+    queue: Ring<[u8; 8], QUEUE>,
     last_sent_us: Option<u64>,
     /// Frames lost because the queue was full (CAN overrun of our own making).
     pub dropped: u32,
@@ -93,14 +94,20 @@ pub struct EmcyProducer {
     changes: u8,
 }
 
+impl Default for EmcyProducer {
+    fn default() -> Self {
+        EmcyProducer::new()
+    }
+}
+
 impl EmcyProducer {
     pub const fn new() -> Self {
-        EmcyProducer { active: Vec::new(), queue: Deque::new(), last_sent_us: None, dropped: 0, combine: false, changes: 0 }
+        EmcyProducer { active: Vec::new(), queue: Ring::new([0; 8]), last_sent_us: None, dropped: 0, combine: false, changes: 0 }
     }
 
     /// A producer whose frames carry the OR of every active error's manufacturer bytes.
     pub const fn combining() -> Self {
-        EmcyProducer { active: Vec::new(), queue: Deque::new(), last_sent_us: None, dropped: 0, combine: true, changes: 0 }
+        EmcyProducer { active: Vec::new(), queue: Ring::new([0; 8]), last_sent_us: None, dropped: 0, combine: true, changes: 0 }
     }
 
     /// The manufacturer bytes of a frame sent now: the raised error's own (`own`), or the OR

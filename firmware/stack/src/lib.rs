@@ -28,6 +28,7 @@ pub mod nmt;
 pub mod node;
 pub mod od;
 pub mod pdo;
+pub(crate) mod ring;
 pub mod sdo;
 pub mod store;
 pub(crate) mod time;

@@ -29,9 +29,10 @@ use crate::leds::Leds;
 use crate::nmt::{self, NmtCommand, NmtState};
 use crate::od::{AccessContext, Area, EntryAccess, NodeDictionary, SdoAbort, Side};
 use crate::pdo::{Rpdo, Tpdo};
+use crate::ring::Ring;
 use crate::sdo::SdoServer;
 use crate::store::ParamStore;
-use heapless::{Deque, Vec};
+use heapless::Vec;
 
 pub use crate::config::NodeConfig;
 
@@ -87,8 +88,8 @@ pub struct Core<D, S, const P: usize> {
     /// The CAN side runs: frames are received and sent (CO401GW1's host enables it).
     can_enabled: bool,
     now_us: u64,
-    tx: Deque<CanFrame, TX_QUEUE>,
-    events: Deque<NodeEvent, EVENTS>,
+    tx: Ring<CanFrame, TX_QUEUE>,
+    events: Ring<NodeEvent, EVENTS>,
     /// Frames dropped because the transmit queue was full.
     pub tx_overflows: u32,
     emcy: EmcyProducer,
@@ -138,8 +139,8 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
             powered: false,
             can_enabled: false,
             now_us: 0,
-            tx: Deque::new(),
-            events: Deque::new(),
+            tx: Ring::new(CanFrame { id: 0, rtr: false, dlc: 0, data: [0; 8] }),
+            events: Ring::new(NodeEvent::ResetApplication),
             tx_overflows: 0,
             emcy: if cfg.combine_emcy_codes { EmcyProducer::combining() } else { EmcyProducer::new() },
             emcy_cob: None,
