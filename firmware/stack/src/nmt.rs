@@ -20,10 +20,11 @@ impl NmtCommand {
     /// Parses an NMT frame payload `[command, node-ID]`; `None` if it is not for `node_id`
     /// (node-ID 0 addresses every node) or is not a valid command.
     pub fn parse(payload: &[u8], node_id: u8) -> Option<NmtCommand> {
-        let [cs, target] = *payload else { return None };
-        if target != 0 && target != node_id {
-            return None;
-        }
+        addressed(payload, node_id).and_then(NmtCommand::from_code)
+    }
+
+    /// The command of a command specifier; `None` for a specifier CiA 301 does not define.
+    pub const fn from_code(cs: u8) -> Option<NmtCommand> {
         Some(match cs {
             0x01 => NmtCommand::Start,
             0x02 => NmtCommand::Stop,
@@ -43,6 +44,14 @@ impl NmtCommand {
             NmtCommand::ResetCommunication => 0x82,
         }
     }
+}
+
+/// The command specifier of an NMT frame payload `[command, node-ID]` addressed to `node_id`
+/// or to every node (node-ID 0), whether CiA 301 defines the command or not; `None` if the
+/// payload is not 2 bytes or addresses another node.
+pub fn addressed(payload: &[u8], node_id: u8) -> Option<u8> {
+    let [cs, target] = *payload else { return None };
+    (target == 0 || target == node_id).then_some(cs)
 }
 
 /// The state byte of heartbeat and guarding answers (boot-up is 0).
@@ -89,6 +98,10 @@ mod tests {
         assert_eq!(NmtCommand::parse(&[0x03, 5], 5), None);
         assert_eq!(NmtCommand::parse(&[0x01], 5), None);
         assert_eq!(NmtCommand::parse(&[0x01, 5, 0], 5), None, "NMT frames are exactly 2 bytes");
+        assert_eq!(addressed(&[0x03, 5], 5), Some(0x03), "an undefined command is still addressed to the node");
+        assert_eq!(addressed(&[0x81, 0], 5), Some(0x81));
+        assert_eq!(addressed(&[0x01, 6], 5), None);
+        assert_eq!(addressed(&[0x01], 5), None);
         for c in [NmtCommand::Start, NmtCommand::Stop, NmtCommand::EnterPreOperational, NmtCommand::ResetNode, NmtCommand::ResetCommunication] {
             assert_eq!(NmtCommand::parse(&[c.code(), 0], 1), Some(c));
         }

@@ -14,8 +14,9 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         if nmt::allows_emcy_and_sync(self.state)
             && let Some(cob) = self.emcy_cob
             && let Some(frame) = self.emcy.next(self.now_us, self.emcy_inhibit)
+            && self.send(cob, &frame)
         {
-            self.send(cob, &frame);
+            self.event(NodeEvent::EmergencySent(frame));
         }
     }
 

@@ -20,6 +20,8 @@ mod errors;
 mod monitoring;
 mod process_data;
 mod target;
+#[cfg(test)]
+mod tests;
 
 use crate::emcy::{EmcyDefault, EmcyEvent, EmcyProducer};
 use crate::frame::CanFrame;
@@ -68,10 +70,18 @@ pub enum NodeEvent {
     RpdoReceived(u16),
     /// The bus-off restart time elapsed: restart the CAN controller.
     RestartController,
+    /// An emergency frame went into the transmit queue: its 8 data bytes as sent (error code,
+    /// error register, manufacturer bytes). Not raised for a frame the full queue lost.
+    EmergencySent([u8; 8]),
+    /// An NMT module control frame addressed to this node or to all nodes arrived: its command
+    /// specifier (byte 0), raised before the command takes effect, whether it changes the
+    /// state or not, and for specifiers CiA 301 does not define.
+    NmtReceived(u8),
 }
 
 const TX_QUEUE: usize = 12;
-const EVENTS: usize = 4;
+/// Events waiting for the device code; when full, the oldest is dropped for a new one.
+const EVENTS: usize = 8;
 
 /// Everything except the SDO server, which borrows it as its [`crate::sdo::SdoTarget`].
 #[derive(Debug)]
@@ -220,7 +230,9 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
             return;
         }
         if frame.id == nmt::NMT_COB_ID {
-            if let Some(cmd) = NmtCommand::parse(frame.payload(), self.core.node_id) {
+            let Some(cs) = nmt::addressed(frame.payload(), self.core.node_id) else { return };
+            self.core.event(NodeEvent::NmtReceived(cs));
+            if let Some(cmd) = NmtCommand::from_code(cs) {
                 if matches!(cmd, NmtCommand::ResetNode | NmtCommand::ResetCommunication | NmtCommand::Stop) {
                     self.sdo.reset();
                 }
@@ -355,8 +367,9 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         AccessContext { nmt: self.state, can_enabled: self.can_enabled }
     }
 
-    fn send(&mut self, id: u16, data: &[u8]) {
-        self.queue(CanFrame::data(id, data));
+    /// Queues a frame; `false` if it was lost (an invalid identifier, or a full queue).
+    fn send(&mut self, id: u16, data: &[u8]) -> bool {
+        self.queue(CanFrame::data(id, data))
     }
 
     /// Sends the first `len` bytes of `data` (a packed PDO).
@@ -364,11 +377,13 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         self.queue(CanFrame::from_payload(id, data, len));
     }
 
-    fn queue(&mut self, frame: Option<CanFrame>) {
-        let Some(frame) = frame else { return };
-        if self.tx.push_back(frame).is_err() {
+    fn queue(&mut self, frame: Option<CanFrame>) -> bool {
+        let Some(frame) = frame else { return false };
+        let queued = self.tx.push_back(frame).is_ok();
+        if !queued {
             self.tx_overflows = self.tx_overflows.saturating_add(1);
         }
+        queued
     }
 
     fn send_sdo(&mut self, payload: [u8; 8]) {

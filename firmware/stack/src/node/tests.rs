@@ -1,0 +1,243 @@
+//! The node over a small hand-written dictionary: one RPDO and one TPDO that both map 2000h,
+//! a heartbeat consumer, and a switch object 2102h. Generated dictionaries are tested through
+//! the devices (`verification`, the simulator); these tests reach the node's own rules.
+
+use super::{BusState, Node, NodeConfig, NodeEvent};
+use crate::emcy::{EmcyDefault, EmcyEvent, Reaction};
+use crate::frame::CanFrame;
+use crate::od::{
+    Access, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NoAppObjects, NodeDictionary, Storage,
+};
+use crate::store::NoStore;
+use crate::value::OdValue;
+use coforge_types::NmtState;
+extern crate std;
+use std::vec::Vec;
+
+const ID: u8 = 5;
+
+const fn entry(index: u16, sub: u8, data_type: DataType, access: Access) -> EntryInfo {
+    let size = match data_type {
+        DataType::Unsigned8 => 1,
+        _ => 4,
+    };
+    let flags = EntryFlags::new(HostAccess::Rw, Storage::Ram);
+    EntryInfo {
+        index,
+        object: 0,
+        size,
+        sub,
+        last_sub: sub,
+        limits: 0,
+        kind: EntryKind::new(data_type, access),
+        flags: if index == 0x2000 { flags.pdo_mappable() } else { flags },
+    }
+}
+
+const U8: DataType = DataType::Unsigned8;
+const U32: DataType = DataType::Unsigned32;
+
+/// Every entry with its default (`$NODEID` added where the flag says so).
+const TABLE: [(EntryInfo, u32, bool); 17] = [
+    (entry(0x1000, 0, U32, Access::Ro), 0x191, false),
+    (entry(0x1001, 0, U8, Access::Ro), 0, false),
+    (entry(0x1016, 0, U8, Access::Ro), 1, false),
+    (entry(0x1016, 1, U32, Access::Rw), 0, false),
+    (entry(0x1400, 0, U8, Access::Ro), 2, false),
+    (entry(0x1400, 1, U32, Access::Rw), 0x200, true),
+    (entry(0x1400, 2, U8, Access::Rw), 255, false),
+    (entry(0x1600, 0, U8, Access::Rw), 1, false),
+    (entry(0x1600, 1, U32, Access::Rw), 0x2000_0008, false),
+    (entry(0x1800, 0, U8, Access::Ro), 2, false),
+    (entry(0x1800, 1, U32, Access::Rw), 0x180, true),
+    (entry(0x1800, 2, U8, Access::Rw), 255, false),
+    (entry(0x1A00, 0, U8, Access::Rw), 1, false),
+    (entry(0x1A00, 1, U32, Access::Rw), 0x2000_0008, false),
+    (entry(0x2000, 0, U8, Access::Rw), 0, false),
+    (entry(0x2001, 0, U8, Access::Rw), 0, false),
+    (entry(0x2102, 0, U8, Access::Ro), 1, false),
+];
+
+static ENTRIES: [EntryInfo; 17] = {
+    let mut out = [entry(0, 0, U8, Access::Ro); 17];
+    let mut i = 0;
+    while i < out.len() {
+        out[i] = TABLE[i].0;
+        i += 1;
+    }
+    out
+};
+
+/// The test dictionary: each entry's value in a byte or a word, by its place in the table.
+#[derive(Debug)]
+pub(super) struct TestOd {
+    bytes: [u8; 17],
+    words: [u32; 17],
+    emergencies: &'static [EmcyDefault],
+    app: NoAppObjects,
+}
+
+impl EntryAccess for TestOd {
+    type App = NoAppObjects;
+
+    fn entries(&self) -> &'static [EntryInfo] {
+        &ENTRIES
+    }
+
+    fn limits(&self) -> &'static [Limits] {
+        &[]
+    }
+
+    fn field(&mut self, info: &EntryInfo, sub: u8) -> Option<&mut dyn OdValue> {
+        let at = ENTRIES.iter().position(|e| e.index == info.index && e.sub == sub)?;
+        if info.size == 1 { Some(&mut self.bytes[at]) } else { Some(&mut self.words[at]) }
+    }
+
+    fn app(&mut self) -> &mut NoAppObjects {
+        &mut self.app
+    }
+}
+
+impl NodeDictionary for TestOd {
+    type Mode = ();
+    const MODES: &'static [()] = &[()];
+    const PERSISTENT_SIZE: usize = 0;
+    const SDO_BLOCK_TRANSFER: bool = false;
+    const COMM: CommObjects = CommObjects { error_history: false, sync_cycle: false, heartbeat_consumer: true };
+
+    fn save_area(&self, _: Area, _: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+        true
+    }
+
+    fn load_area(&mut self, _: Area, _: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+        true
+    }
+
+    fn reset_area(&mut self, area: Area, node_id: u8) {
+        for (at, (info, default, plus_id)) in TABLE.iter().enumerate() {
+            if area.contains(info.index) {
+                let value = default + if *plus_id { u32::from(node_id) } else { 0 };
+                self.bytes[at] = value as u8;
+                self.words[at] = value;
+            }
+        }
+    }
+
+    fn emergencies(&self) -> &'static [EmcyDefault] {
+        self.emergencies
+    }
+
+    fn emergency_named(&self, _: &str) -> Option<EmcyDefault> {
+        None
+    }
+
+    fn new(_: (), node_id: u8, app: NoAppObjects) -> Self {
+        let mut od = TestOd { bytes: [0; 17], words: [0; 17], emergencies: &[], app };
+        od.reset_area(Area::ALL, node_id);
+        od
+    }
+
+    fn mode(&self) {}
+
+    fn set_mode(&mut self, _: (), _: u8) {}
+
+    fn mode_name(_: ()) -> &'static str {
+        "test"
+    }
+
+    fn node_config(node_id: u8) -> NodeConfig {
+        NodeConfig::new(node_id)
+    }
+}
+
+type TestNode = Node<TestOd, NoStore, 8, 1>;
+
+/// A started node with the spec emergencies `emergencies`, its boot-up sent and its events
+/// taken.
+fn node(cfg: NodeConfig, emergencies: &'static [EmcyDefault]) -> TestNode {
+    let mut od = TestOd::new((), ID, NoAppObjects);
+    od.emergencies = emergencies;
+    let mut n = Node::new(od, NoStore, cfg);
+    n.start(0);
+    frames(&mut n, 0);
+    events(&mut n);
+    n
+}
+
+fn frames(n: &mut TestNode, now: u64) -> Vec<CanFrame> {
+    core::iter::from_fn(|| n.poll(now)).collect()
+}
+
+fn events(n: &mut TestNode) -> Vec<NodeEvent> {
+    core::iter::from_fn(|| n.take_event()).collect()
+}
+
+/// The data of the emergency frames among `frames`.
+fn emergencies(frames: &[CanFrame]) -> Vec<[u8; 8]> {
+    frames.iter().filter(|f| f.id == 0x80 + u16::from(ID)).map(|f| f.data).collect()
+}
+
+fn nmt(n: &mut TestNode, cs: u8, target: u8) {
+    n.on_frame(&CanFrame::data(0x000, &[cs, target]).unwrap(), 0);
+}
+
+#[test]
+fn nmt_commands_for_this_node_are_reported_before_they_act() {
+    let mut n = node(NodeConfig::new(ID), &[]);
+    nmt(&mut n, 0x01, ID);
+    assert_eq!(events(&mut n), [NodeEvent::NmtReceived(0x01), NodeEvent::StateChanged(NmtState::Operational)]);
+    nmt(&mut n, 0x01, 0);
+    assert_eq!(events(&mut n), [NodeEvent::NmtReceived(0x01)], "broadcast, and reported though the state stays");
+    nmt(&mut n, 0x80, ID + 1);
+    assert_eq!(events(&mut n), [], "another node's command");
+    assert_eq!(n.state(), NmtState::Operational);
+    nmt(&mut n, 0x03, 0);
+    assert_eq!(events(&mut n), [NodeEvent::NmtReceived(0x03)], "a specifier CiA 301 does not define");
+    n.on_frame(&CanFrame::data(0x000, &[0x02, ID, 0]).unwrap(), 0);
+    assert_eq!(events(&mut n), [], "not an NMT command: 3 bytes");
+    nmt(&mut n, 0x81, ID);
+    let after_reset = events(&mut n);
+    assert_eq!(after_reset.first(), Some(&NodeEvent::NmtReceived(0x81)));
+    assert_eq!(after_reset.get(1), Some(&NodeEvent::ResetApplication));
+}
+
+#[test]
+fn every_emergency_queued_is_reported_with_its_bytes() {
+    static SPEC: [EmcyDefault; 1] = [EmcyDefault {
+        code: 0x8100,
+        register: 0x11,
+        manufacturer: [0, 0, 0, 0, 0x40],
+        reaction: Reaction::None,
+        event: Some(EmcyEvent::CanWarning),
+        enabled_by: None,
+    }];
+    let mut n = node(NodeConfig::new(ID), &SPEC);
+    n.on_bus_state(BusState::Warning, 1_000);
+    n.on_bus_state(BusState::Passive, 2_000);
+    n.on_bus_state(BusState::Active, 3_000);
+    let sent = emergencies(&frames(&mut n, 3_000));
+    assert_eq!(
+        sent,
+        [[0x00, 0x81, 0x11, 0, 0, 0, 0, 0x40], [0x20, 0x81, 0x11, 0, 0, 0, 0, 0], [0, 0, 0x11, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0, 0, 0]],
+        "spec warning, CiA passive, two error resets"
+    );
+    let reported: Vec<[u8; 8]> = events(&mut n)
+        .into_iter()
+        .filter_map(|e| match e {
+            NodeEvent::EmergencySent(data) => Some(data),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(reported, sent, "one event per frame, its bytes as sent");
+}
+
+#[test]
+fn the_event_queue_keeps_the_newest_eight() {
+    let mut n = node(NodeConfig::new(ID), &[]);
+    for cs in 0x10..0x1A {
+        nmt(&mut n, cs, ID);
+    }
+    let kept: Vec<NodeEvent> = (0x12..0x1A).map(NodeEvent::NmtReceived).collect();
+    assert_eq!(events(&mut n), kept, "10 events: the 2 oldest are dropped");
+    assert_eq!(n.take_event(), None);
+}
