@@ -6,6 +6,7 @@ use crate::emcy::{EmcyDefault, EmcyEvent, Reaction};
 use crate::leds::{LedState, Leds};
 use crate::nmt::{self, NmtState};
 use crate::od::{NodeDictionary, Side};
+use crate::pdo::slot::NEVER;
 use crate::store::ParamStore;
 
 impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
@@ -22,10 +23,13 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
 
     /// Bus-off: tells the board to restart the controller once the restart time has passed.
     pub(super) fn check_restart(&mut self, now_us: u64) {
-        let Some(since) = self.bus_off_since else { return };
+        let since = self.bus_off_since;
+        if since == NEVER {
+            return;
+        }
         let restart_ms = self.cfg.restart_time_object.and_then(|i| read_u32(&mut self.od, i, 0));
         if restart_ms.is_some_and(|ms| ms != 0 && now_us.saturating_sub(since) >= u64::from(ms) * 1000) {
-            self.bus_off_since = None;
+            self.bus_off_since = NEVER;
             self.event(NodeEvent::RestartController);
         }
     }
@@ -37,7 +41,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
         match bus {
             BusState::BusOff => {
-                self.bus_off_since = Some(now_us);
+                self.bus_off_since = now_us;
                 self.raise_event(EmcyEvent::BusOff);
             }
             BusState::Warning => self.raise_event(EmcyEvent::CanWarning),
@@ -45,7 +49,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             BusState::Active => {}
         }
         if was == BusState::BusOff && bus != BusState::BusOff {
-            self.bus_off_since = None;
+            self.bus_off_since = NEVER;
             self.clear_event(EmcyEvent::BusOff);
             // "Return from bus-off" is an event, not a condition: raised and cleared at once.
             self.raise_event(EmcyEvent::BusOffRecovered);

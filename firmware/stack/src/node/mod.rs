@@ -30,6 +30,7 @@ use crate::heartbeat::{Consumer, ConsumerEvent, Producer};
 use crate::leds::Leds;
 use crate::nmt::{self, NmtCommand, NmtState};
 use crate::od::{AccessContext, Area, EntryAccess, NodeDictionary, SdoAbort, Side};
+use crate::pdo::slot::NEVER;
 use crate::pdo::{Rpdo, Tpdo};
 use crate::ring::Ring;
 use crate::sdo::SdoServer;
@@ -108,8 +109,9 @@ pub struct Core<D, S, const P: usize> {
     sync_cob: Option<u16>,
     /// 1006h communication cycle period in us (0: SYNC not monitored).
     sync_period_us: u32,
-    /// When the last SYNC arrived; monitoring starts with the first one.
-    last_sync_us: Option<u64>,
+    /// When the last SYNC arrived, [`NEVER`] before the first: monitoring starts with it.
+    /// (Plain `u64`s here and in `bus_off_since`: `Option` would double each.)
+    last_sync_us: u64,
     /// The SYNC timeout was reported and waits for the next SYNC to end it.
     sync_lost: bool,
     heartbeat: Producer,
@@ -123,7 +125,8 @@ pub struct Core<D, S, const P: usize> {
     /// An RPDO length error is active (cleared by the next correct RPDO).
     rpdo_length_error: bool,
     bus: BusState,
-    bus_off_since: Option<u64>,
+    /// When the controller went bus-off; [`NEVER`] while it is not (or was restarted).
+    bus_off_since: u64,
 }
 
 /// A CANopen slave node over dictionary `D` and parameter store `S`; `N` is the SDO download
@@ -157,7 +160,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
             emcy_inhibit: 0,
             sync_cob: None,
             sync_period_us: 0,
-            last_sync_us: None,
+            last_sync_us: NEVER,
             sync_lost: false,
             heartbeat: Producer::default(),
             consumer: Consumer::default(),
@@ -168,7 +171,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
             tpdo_mapped: 0,
             rpdo_length_error: false,
             bus: BusState::Active,
-            bus_off_since: None,
+            bus_off_since: NEVER,
         };
         Node { core, sdo }
     }
@@ -404,7 +407,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             if state != NmtState::Operational {
                 for r in &mut self.rpdos {
                     r.latched = None;
-                    r.deadline_us = crate::pdo::slot::NEVER;
+                    r.deadline_us = NEVER;
                 }
             } else {
                 let now = self.now_us;
@@ -443,7 +446,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         self.state = NmtState::PreOperational;
         self.reload_all(now_us);
         self.mirror_error_register(0);
-        self.last_sync_us = None;
+        self.last_sync_us = NEVER;
         self.sync_lost = false;
         if self.cfg.bootup_object.and_then(|i| read_u32(&mut self.od, i, 0)) != Some(0) {
             self.send(0x700 + u16::from(self.node_id), &[0x00]);
@@ -477,7 +480,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
                 [c] => Some(*c),
                 _ => return,
             };
-            self.last_sync_us = Some(now_us);
+            self.last_sync_us = now_us;
             if core::mem::take(&mut self.sync_lost) {
                 self.clear_event(EmcyEvent::SyncTimeout);
             }

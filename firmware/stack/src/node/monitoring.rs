@@ -34,7 +34,8 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             && period != 0
             && nmt::allows_emcy_and_sync(self.state)
             && !self.sync_lost
-            && self.last_sync_us.is_some_and(|t| now_us.saturating_sub(t) > period + period / 2)
+            // Before the first SYNC, `last_sync_us` is NEVER and the difference 0.
+            && now_us.saturating_sub(self.last_sync_us) > period + period / 2
         {
             // Reported once; the next SYNC ends it.
             self.sync_lost = true;
