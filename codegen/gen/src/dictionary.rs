@@ -515,6 +515,7 @@ fn node_config(d: &Device, stack: &TokenStream) -> TokenStream {
     };
     let (restart, bootup, startup) = (object(n.restart_time_object), object(n.bootup_object), object(n.startup_object));
     let (deadlines, combine, auto_save) = (n.rpdo_deadline_monitoring, n.combine_emcy_codes, n.auto_save);
+    let listed_only = n.listed_emergencies_only;
     quote! {
         #stack::config::NodeConfig {
             restart_time_object: #restart,
@@ -523,6 +524,7 @@ fn node_config(d: &Device, stack: &TokenStream) -> TokenStream {
             rpdo_deadlines: #deadlines,
             combine_emcy_codes: #combine,
             auto_save: #auto_save,
+            listed_emergencies_only: #listed_only,
             ..#stack::config::NodeConfig::new(node_id)
         }
     }

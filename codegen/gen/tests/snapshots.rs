@@ -19,6 +19,18 @@ fn generated_code_of_every_spec() {
 }
 
 #[test]
+fn the_node_section_becomes_node_config() {
+    let path = repo().join("codegen/spec/tests/fixtures/valid/minimal.yaml");
+    let device = coforge_spec::load_file(&path).into_device().expect("the fixture loads");
+    let code = pretty(generate(&device, &Options::default())).expect("generates");
+    let start = code.find("pub const fn node_config").expect("node_config");
+    let body = &code[start..start + code[start..].find("\n}").expect("its end")];
+    for field in ["restart_time_object: Some(0x2000)", "rpdo_deadlines: false", "listed_emergencies_only: true"] {
+        assert!(body.contains(field), "{field} in\n{body}");
+    }
+}
+
+#[test]
 fn an_invalid_spec_expands_to_its_diagnostics() {
     let spec = "codegen/spec/tests/fixtures/invalid/od-duplicate.yaml";
     let err = expand(spec, &repo(), &Options::default()).err().unwrap_or_default();

@@ -223,6 +223,14 @@ fn node(out: &mut String, d: &Device) {
             flag(n.combine_emcy_codes, "emergency bytes 3..7 carry the OR of every active error's bytes", "emergency bytes 3..7 are those of the error sent"),
         ),
         ("auto_save", flag(n.auto_save, "persistent entries are saved as soon as they are written", "persistent entries are saved by a write to 1010")),
+        (
+            "listed_emergencies_only",
+            flag(
+                n.listed_emergencies_only,
+                "a stack event sends only the emergency listed for it, none if none is",
+                "a stack event without a listed emergency sends the CiA 301 one",
+            ),
+        ),
     ];
     let _ = writeln!(out, "## CANopen node\n\nHow the node differs from a plain CiA 301 slave (spec `node:`).\n\n| Setting | Value |\n|---|---|");
     for (key, value) in rows {

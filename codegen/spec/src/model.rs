@@ -53,10 +53,13 @@ pub struct NodeSettings {
     pub rpdo_deadline_monitoring: bool,
     pub combine_emcy_codes: bool,
     pub auto_save: bool,
+    /// Stack events send only the emergencies the spec lists (no CiA 301 defaults).
+    pub listed_emergencies_only: bool,
 }
 
 /// Plain CiA 301: no device-specific objects, RPDO deadline monitoring on, emergency
-/// manufacturer bytes not combined, persistent entries saved only through 1010.
+/// manufacturer bytes not combined, persistent entries saved only through 1010, the CiA 301
+/// emergency for a stack event the spec lists none for.
 impl Default for NodeSettings {
     fn default() -> Self {
         NodeSettings {
@@ -66,6 +69,7 @@ impl Default for NodeSettings {
             rpdo_deadline_monitoring: true,
             combine_emcy_codes: false,
             auto_save: false,
+            listed_emergencies_only: false,
         }
     }
 }

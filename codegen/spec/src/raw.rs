@@ -118,6 +118,8 @@ pub struct Node {
     pub combine_emcy_codes: Option<bool>,
     #[serde(default)]
     pub auto_save: Option<bool>,
+    #[serde(default)]
+    pub listed_emergencies_only: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -148,7 +148,8 @@ fn node_settings_are_what_each_firmware_needs() {
             startup_object: None,
             rpdo_deadline_monitoring: true,
             combine_emcy_codes: false,
-            auto_save: false
+            auto_save: false,
+            listed_emergencies_only: false,
         }
     );
     let expected = [
@@ -195,4 +196,12 @@ fn fixture_eds_and_docs_match_golden_files() {
     failures.extend(golden(&crate_dir().join("tests/golden/minimal.md"), &coforge_spec::docs::markdown(&d)));
     failures.extend(golden(&crate_dir().join("tests/golden/minimal-digital.json"), &eds::model_json(&d, Some("digital"), 5).expect("json")));
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn the_fixture_node_section_is_read_whole() {
+    let text = std::fs::read_to_string(crate_dir().join("tests/fixtures/valid/minimal.yaml")).unwrap_or_default();
+    let d = load_str("minimal.yaml", &text).into_device().expect("loads");
+    let want = NodeSettings { restart_time_object: Some(0x2000), rpdo_deadline_monitoring: false, listed_emergencies_only: true, ..NodeSettings::default() };
+    assert_eq!(d.node, want);
 }

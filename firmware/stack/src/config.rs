@@ -24,6 +24,10 @@ pub struct NodeConfig {
     /// An RPDO's event timer (14xxh.5) is a deadline monitor (CiA 301 4.2, EMCY 8250h). Off
     /// for DS301 4.0 devices, where the entry exists but has no function for RPDOs.
     pub rpdo_deadlines: bool,
+    /// A stack event (CAN warning or passive, RPDO length, SYNC or RPDO timeout, guarding,
+    /// heartbeat) sends only the emergency the spec lists for it: without one, no EMCY frame
+    /// and no error-register bit, though a communication error still gets its 1029h reaction.
+    pub listed_emergencies_only: bool,
 }
 
 impl NodeConfig {
@@ -37,6 +41,7 @@ impl NodeConfig {
             bootup_object: None,
             combine_emcy_codes: false,
             rpdo_deadlines: true,
+            listed_emergencies_only: false,
         }
     }
 }

@@ -62,6 +62,7 @@ pub(super) fn node_settings(cx: &mut Cx<'_>, n: &S<raw::Node>) -> (NodeSettings,
         rpdo_deadline_monitoring: v.rpdo_deadline_monitoring.unwrap_or(defaults.rpdo_deadline_monitoring),
         combine_emcy_codes: v.combine_emcy_codes.unwrap_or(defaults.combine_emcy_codes),
         auto_save: v.auto_save.unwrap_or(defaults.auto_save),
+        listed_emergencies_only: v.listed_emergencies_only.unwrap_or(defaults.listed_emergencies_only),
     };
     (settings, NodeSpans { restart_time_object: restart_span, bootup_object: bootup_span, startup_object: startup_span })
 }

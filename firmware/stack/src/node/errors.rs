@@ -61,13 +61,17 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
     }
 
-    /// The spec emergency for a stack event. Events whose frame is device-specific are only
-    /// sent if the spec lists them: the guarding warning, and bus-off and its end (a node
-    /// cannot send while bus-off; datasheets differ in what goes out on the return).
+    /// The emergency a stack event sends: the spec's, else the CiA 301 default. This is the
+    /// only place the node makes a default emergency, and it makes none where a device sends
+    /// only what its spec lists (`listed_emergencies_only`). Events whose frame is
+    /// device-specific are only sent if the spec lists them: the guarding warning, and bus-off
+    /// and its end (a node cannot send while bus-off; datasheets differ in what goes out on
+    /// the return).
     pub(super) fn event_emcy(&self, event: EmcyEvent) -> Option<EmcyDefault> {
         // One search of the spec's list; the CiA 301 default only where none is listed.
         match (self.od.emergencies().iter().find(|e| e.event == Some(event)), event) {
             (Some(e), _) => Some(*e),
+            (None, _) if self.cfg.listed_emergencies_only => None,
             (None, EmcyEvent::GuardingWarning | EmcyEvent::BusOff | EmcyEvent::BusOffRecovered) => None,
             (None, _) => Some(EmcyDefault::for_event(event, &[])),
         }

@@ -6,7 +6,7 @@ use super::{BusState, Node, NodeConfig, NodeEvent};
 use crate::emcy::{EmcyDefault, EmcyEvent, Reaction};
 use crate::frame::CanFrame;
 use crate::od::{
-    Access, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NoAppObjects, NodeDictionary, Storage,
+    Access, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NoAppObjects, NodeDictionary, Side, Storage,
 };
 use crate::store::NoStore;
 use crate::value::OdValue;
@@ -240,4 +240,69 @@ fn the_event_queue_keeps_the_newest_eight() {
     let kept: Vec<NodeEvent> = (0x12..0x1A).map(NodeEvent::NmtReceived).collect();
     assert_eq!(events(&mut n), kept, "10 events: the 2 oldest are dropped");
     assert_eq!(n.take_event(), None);
+}
+
+/// The CAN warning as a datasheet lists it (CO401GW1 "can_error_warning").
+static WARNING_ONLY: [EmcyDefault; 1] = [EmcyDefault {
+    code: 0x8100,
+    register: 0x11,
+    manufacturer: [0, 0, 0, 0, 0x40],
+    reaction: Reaction::None,
+    event: Some(EmcyEvent::CanWarning),
+    enabled_by: None,
+}];
+
+/// Operational, then a CAN warning, CAN passive, a too short RPDO and a lost heartbeat
+/// (1016h.1 watches node 3 for 100 ms): the emergencies sent, 1001h, and the state after.
+fn stack_events(cfg: NodeConfig) -> (Vec<[u8; 8]>, u8, NmtState) {
+    let mut n = node(cfg, &WARNING_ONLY);
+    assert_eq!(n.write(0x1016, 1, &(3_u32 << 16 | 100).to_le_bytes(), Side::Device), Ok(()));
+    nmt(&mut n, 0x01, ID);
+    n.on_frame(&CanFrame::data(0x703, &[0x05]).unwrap(), 0);
+    let mut sent = Vec::new();
+    n.on_bus_state(BusState::Warning, 1_000);
+    n.on_bus_state(BusState::Passive, 2_000);
+    n.on_frame(&CanFrame::data(0x205, &[]).unwrap(), 3_000);
+    sent.extend(emergencies(&frames(&mut n, 3_000)));
+    assert_eq!(n.state(), NmtState::Operational);
+    sent.extend(emergencies(&frames(&mut n, 101_000)));
+    let mut register = [0];
+    n.read(0x1001, 0, 0, &mut register, Side::Bus).unwrap();
+    assert_eq!(register[0], n.error_register(), "1001h mirrors the producer");
+    (sent, register[0], n.state())
+}
+
+#[test]
+fn by_default_unlisted_stack_events_send_their_cia_301_emergency() {
+    let (sent, register, state) = stack_events(NodeConfig::new(ID));
+    assert_eq!(
+        sent,
+        [
+            [0x00, 0x81, 0x11, 0, 0, 0, 0, 0x40], // the listed CAN warning
+            [0x20, 0x81, 0x11, 0, 0, 0, 0, 0],    // CAN passive, CiA 301
+            [0x10, 0x82, 0x11, 0, 0, 0, 0, 0],    // RPDO length, CiA 301
+            [0x30, 0x81, 0x11, 0, 0, 0, 0, 0],    // heartbeat consumer, CiA 301
+        ]
+    );
+    assert_eq!(register, 0x11);
+    assert_eq!(state, NmtState::PreOperational, "1029h sub 1 absent = 0: a communication error leaves Operational");
+}
+
+#[test]
+fn listed_emergencies_only_sends_nothing_the_spec_does_not_list() {
+    let cfg = NodeConfig { listed_emergencies_only: true, ..NodeConfig::new(ID) };
+    let (sent, register, state) = stack_events(cfg);
+    assert_eq!(sent, [[0x00, 0x81, 0x11, 0, 0, 0, 0, 0x40]], "only the listed CAN warning");
+    assert_eq!(register, 0x11, "the warning's bits only");
+    assert_eq!(state, NmtState::PreOperational, "the lost heartbeat still gets its 1029h reaction");
+    // Without the listed warning active, the unlisted events leave 1001h at 0.
+    let mut n = node(cfg, &WARNING_ONLY);
+    n.on_bus_state(BusState::Passive, 1_000);
+    nmt(&mut n, 0x01, ID);
+    n.on_frame(&CanFrame::data(0x205, &[]).unwrap(), 2_000);
+    assert_eq!(emergencies(&frames(&mut n, 2_000)), Vec::<[u8; 8]>::new());
+    assert_eq!(n.error_register(), 0);
+    assert!(!n.is_active(&EmcyDefault::for_event(EmcyEvent::CanPassive, &[])));
+    n.on_bus_state(BusState::Active, 3_000);
+    assert_eq!(emergencies(&frames(&mut n, 3_000)), Vec::<[u8; 8]>::new(), "no error reset for what was never sent");
 }
