@@ -48,3 +48,24 @@ fn listed_emergencies_only_leaves_out_the_cia_301_defaults() {
     assert_eq!(all.last(), Some(&[0x00, 0x81, 0x11, 0, 0, 0, 0, 0x40]), "the warning, with the RPDO length error's communication bit still set");
     assert_eq!(unlisted_then_listed(true), [[0x00, 0x81, 0x01, 0, 0, 0, 0, 0x40]], "only the spec's own emergency, and no bit of an unlisted one");
 }
+
+/// Operational at `now`; the TPDO1 payloads (digital input bytes 6000h.1..8) sent after a
+/// device write of input byte 0, and after the device's own trigger of 6000h.1.
+fn tpdo1_after_write_and_trigger(on_write: bool) -> (Vec<Vec<u8>>, Vec<Vec<u8>>) {
+    let mut n = gw1(|c| NodeConfig { tpdo_on_write: on_write, ..c });
+    n.on_frame(&CanFrame::data(0x000, &[0x01, ID]).unwrap(), 1_000);
+    drain(&mut n, 1_000);
+    let tpdo1 = |frames: Vec<CanFrame>| -> Vec<Vec<u8>> { frames.iter().filter(|f| f.id == 0x180 + u16::from(ID)).map(|f| f.payload().to_vec()).collect() };
+    assert_eq!(n.write(0x6000, 1, &[0xA5], coforge_stack::od::Side::Device), Ok(()));
+    let after_write = tpdo1(drain(&mut n, 2_000));
+    n.trigger_mapped(0x6000, 1);
+    let after_trigger = tpdo1(drain(&mut n, 3_000));
+    (after_write, after_trigger)
+}
+
+#[test]
+fn tpdo_on_write_off_leaves_the_tpdos_to_the_device() {
+    let inputs = vec![0xA5, 0, 0, 0, 0, 0, 0, 0];
+    assert_eq!(tpdo1_after_write_and_trigger(true), (vec![inputs.clone()], vec![inputs.clone()]), "CiA 301: the write triggers TPDO1");
+    assert_eq!(tpdo1_after_write_and_trigger(false), (vec![], vec![inputs]), "only Node::trigger_mapped sends it");
+}

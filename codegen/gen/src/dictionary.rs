@@ -515,7 +515,7 @@ fn node_config(d: &Device, stack: &TokenStream) -> TokenStream {
     };
     let (restart, bootup, startup) = (object(n.restart_time_object), object(n.bootup_object), object(n.startup_object));
     let (deadlines, combine, auto_save) = (n.rpdo_deadline_monitoring, n.combine_emcy_codes, n.auto_save);
-    let listed_only = n.listed_emergencies_only;
+    let (listed_only, tpdo_on_write) = (n.listed_emergencies_only, n.tpdo_on_write);
     quote! {
         #stack::config::NodeConfig {
             restart_time_object: #restart,
@@ -525,6 +525,7 @@ fn node_config(d: &Device, stack: &TokenStream) -> TokenStream {
             combine_emcy_codes: #combine,
             auto_save: #auto_save,
             listed_emergencies_only: #listed_only,
+            tpdo_on_write: #tpdo_on_write,
             ..#stack::config::NodeConfig::new(node_id)
         }
     }

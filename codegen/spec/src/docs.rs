@@ -231,6 +231,14 @@ fn node(out: &mut String, d: &Device) {
                 "a stack event without a listed emergency sends the CiA 301 one",
             ),
         ),
+        (
+            "tpdo_on_write",
+            flag(
+                n.tpdo_on_write,
+                "a write of an entry a valid TPDO maps triggers the TPDO",
+                "writes trigger no TPDO: the device triggers them (`Node::trigger_mapped`)",
+            ),
+        ),
     ];
     let _ = writeln!(out, "## CANopen node\n\nHow the node differs from a plain CiA 301 slave (spec `node:`).\n\n| Setting | Value |\n|---|---|");
     for (key, value) in rows {

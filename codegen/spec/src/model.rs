@@ -55,11 +55,14 @@ pub struct NodeSettings {
     pub auto_save: bool,
     /// Stack events send only the emergencies the spec lists (no CiA 301 defaults).
     pub listed_emergencies_only: bool,
+    /// A write of an entry a valid TPDO maps triggers the TPDO (else the device does).
+    pub tpdo_on_write: bool,
 }
 
 /// Plain CiA 301: no device-specific objects, RPDO deadline monitoring on, emergency
 /// manufacturer bytes not combined, persistent entries saved only through 1010, the CiA 301
-/// emergency for a stack event the spec lists none for.
+/// emergency for a stack event the spec lists none for, TPDOs triggered by writes of what they
+/// map.
 impl Default for NodeSettings {
     fn default() -> Self {
         NodeSettings {
@@ -70,6 +73,7 @@ impl Default for NodeSettings {
             combine_emcy_codes: false,
             auto_save: false,
             listed_emergencies_only: false,
+            tpdo_on_write: true,
         }
     }
 }

@@ -120,6 +120,8 @@ pub struct Node {
     pub auto_save: Option<bool>,
     #[serde(default)]
     pub listed_emergencies_only: Option<bool>,
+    #[serde(default)]
+    pub tpdo_on_write: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]

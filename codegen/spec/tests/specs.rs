@@ -150,6 +150,7 @@ fn node_settings_are_what_each_firmware_needs() {
             combine_emcy_codes: false,
             auto_save: false,
             listed_emergencies_only: false,
+            tpdo_on_write: true,
         }
     );
     let expected = [
@@ -202,6 +203,12 @@ fn fixture_eds_and_docs_match_golden_files() {
 fn the_fixture_node_section_is_read_whole() {
     let text = std::fs::read_to_string(crate_dir().join("tests/fixtures/valid/minimal.yaml")).unwrap_or_default();
     let d = load_str("minimal.yaml", &text).into_device().expect("loads");
-    let want = NodeSettings { restart_time_object: Some(0x2000), rpdo_deadline_monitoring: false, listed_emergencies_only: true, ..NodeSettings::default() };
+    let want = NodeSettings {
+        restart_time_object: Some(0x2000),
+        rpdo_deadline_monitoring: false,
+        listed_emergencies_only: true,
+        tpdo_on_write: false,
+        ..NodeSettings::default()
+    };
     assert_eq!(d.node, want);
 }

@@ -28,6 +28,10 @@ pub struct NodeConfig {
     /// heartbeat) sends only the emergency the spec lists for it: without one, no EMCY frame
     /// and no error-register bit, though a communication error still gets its 1029h reaction.
     pub listed_emergencies_only: bool,
+    /// A write of an entry that a valid TPDO maps triggers that TPDO (CiA 301), whoever
+    /// writes (SDO, RPDO, device, host). Off where the device decides when its TPDOs go out
+    /// (DS401 input rules), through [`Node::trigger_mapped`](crate::node::Node::trigger_mapped).
+    pub tpdo_on_write: bool,
 }
 
 impl NodeConfig {
@@ -42,6 +46,7 @@ impl NodeConfig {
             combine_emcy_codes: false,
             rpdo_deadlines: true,
             listed_emergencies_only: false,
+            tpdo_on_write: true,
         }
     }
 }

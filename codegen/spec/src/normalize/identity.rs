@@ -63,6 +63,7 @@ pub(super) fn node_settings(cx: &mut Cx<'_>, n: &S<raw::Node>) -> (NodeSettings,
         combine_emcy_codes: v.combine_emcy_codes.unwrap_or(defaults.combine_emcy_codes),
         auto_save: v.auto_save.unwrap_or(defaults.auto_save),
         listed_emergencies_only: v.listed_emergencies_only.unwrap_or(defaults.listed_emergencies_only),
+        tpdo_on_write: v.tpdo_on_write.unwrap_or(defaults.tpdo_on_write),
     };
     (settings, NodeSpans { restart_time_object: restart_span, bootup_object: bootup_span, startup_object: startup_span })
 }

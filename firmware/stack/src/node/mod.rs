@@ -4,7 +4,7 @@
 //! ```text
 //! board ──on_frame(frame, now)──▶ Node ──poll(now)──▶ frames to send
 //!                                   │
-//!                  write/raise/trigger_tpdo (device code)
+//!          write/raise/trigger_tpdo/trigger_mapped (device code)
 //! ```
 //! All times are microseconds from an arbitrary epoch; the node never reads a clock itself.
 //! Deadlines saturate at `u64::MAX` (584 000 years) rather than overflow.
@@ -289,7 +289,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
     }
 
     /// Direct access for device code; writes that should trigger TPDOs or auto-save go
-    /// through [`Node::write`].
+    /// through [`Node::write`] (or are followed by [`Node::trigger_mapped`]).
     pub fn od_mut(&mut self) -> &mut D {
         &mut self.core.od
     }
@@ -299,7 +299,8 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
     }
 
     /// A write by the device itself or its serial host, with the same side effects as an SDO
-    /// download: communication-object checks, event-driven TPDOs, auto-save.
+    /// download: communication-object checks, event-driven TPDOs (with `tpdo_on_write`),
+    /// auto-save.
     pub fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
         self.core.write(index, sub, data, side)
     }
@@ -334,6 +335,14 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
     /// The current error register (1001h).
     pub fn error_register(&self) -> u8 {
         self.core.emcy.register()
+    }
+
+    /// An application event for every valid TPDO that maps `index`/`sub`: what a write of
+    /// the entry does by itself unless the spec says `tpdo_on_write: false`. Each such TPDO
+    /// goes out as its transmission type says (event-driven: at the next poll, inhibit time
+    /// permitting; acyclic synchronous: at the next SYNC).
+    pub fn trigger_mapped(&mut self, index: u16, sub: u8) {
+        self.core.trigger_mapped(index, sub);
     }
 
     /// An application event for TPDO `number` (1-based: TPDO1 is 1800h).

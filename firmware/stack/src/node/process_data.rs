@@ -102,6 +102,19 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
     }
 
+    /// Marks every valid TPDO that maps `index`/`sub` (sent as its transmission type says).
+    pub(super) fn trigger_mapped(&mut self, index: u16, sub: u8) {
+        if self.tpdo_mapped & Self::filter_bit(index, sub) == 0 {
+            return;
+        }
+        let entries = self.od.entries();
+        for t in &mut self.tpdos {
+            if t.comm.valid() && t.mapping.contains(entries, index, sub) {
+                t.trigger();
+            }
+        }
+    }
+
     /// The filter bit of one object; a set bit means "maybe mapped".
     pub(super) const fn filter_bit(index: u16, sub: u8) -> u64 {
         1 << ((index ^ index >> 6 ^ (sub as u16).wrapping_mul(7)) & 63)

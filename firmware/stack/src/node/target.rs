@@ -49,20 +49,14 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         result.map_err(|_| SdoAbort::Hardware)
     }
 
-    /// Marks the TPDOs that map a written object, and re-reads what a written communication
-    /// object configures.
+    /// Re-reads what a written communication object configures, and marks the TPDOs that map
+    /// the written entry (unless the device triggers its TPDOs itself: `tpdo_on_write`).
     pub(super) fn after_write(&mut self, index: u16, sub: u8) {
         if index < 0x2000 {
             self.after_communication_write(index);
         }
-        if self.tpdo_mapped & Self::filter_bit(index, sub) == 0 {
-            return;
-        }
-        let entries = self.od.entries();
-        for t in &mut self.tpdos {
-            if t.comm.valid() && t.mapping.contains(entries, index, sub) {
-                t.trigger();
-            }
+        if self.cfg.tpdo_on_write {
+            self.trigger_mapped(index, sub);
         }
     }
 

@@ -12,6 +12,7 @@ use crate::store::NoStore;
 use crate::value::OdValue;
 use coforge_types::NmtState;
 extern crate std;
+use std::vec;
 use std::vec::Vec;
 
 const ID: u8 = 5;
@@ -181,6 +182,32 @@ fn nmt(n: &mut TestNode, cs: u8, target: u8) {
     n.on_frame(&CanFrame::data(0x000, &[cs, target]).unwrap(), 0);
 }
 
+/// An expedited SDO download: `Err` with the abort code if the node refuses it, and the
+/// other frames the node sent meanwhile.
+fn download_with(n: &mut TestNode, index: u16, sub: u8, value: &[u8]) -> (Result<(), u32>, Vec<CanFrame>) {
+    let [lo, hi] = index.to_le_bytes();
+    let mut request = [0x23 | ((4 - value.len() as u8) << 2), lo, hi, sub, 0, 0, 0, 0];
+    request[4..4 + value.len()].copy_from_slice(value);
+    n.on_frame(&CanFrame::data(0x600 + u16::from(ID), &request).unwrap(), 0);
+    let (answers, others): (Vec<CanFrame>, Vec<CanFrame>) = frames(n, 0).into_iter().partition(|f| f.id == 0x580 + u16::from(ID));
+    let [answer] = answers[..] else { panic!("one SDO answer, not {answers:?}") };
+    let result = match answer.data[0] {
+        0x60 => Ok(()),
+        0x80 => Err(u32::from_le_bytes([answer.data[4], answer.data[5], answer.data[6], answer.data[7]])),
+        other => panic!("SDO answer {other:02X}"),
+    };
+    (result, others)
+}
+
+/// The payloads of the TPDO1 frames (0x185) among `frames`.
+fn tpdo1(frames: &[CanFrame]) -> Vec<Vec<u8>> {
+    frames.iter().filter(|f| f.id == 0x180 + u16::from(ID)).map(|f| f.payload().to_vec()).collect()
+}
+
+fn read_u8(n: &mut TestNode, index: u16) -> u8 {
+    super::read_u32(n.od_mut(), index, 0).unwrap() as u8
+}
+
 #[test]
 fn nmt_commands_for_this_node_are_reported_before_they_act() {
     let mut n = node(NodeConfig::new(ID), &[]);
@@ -305,4 +332,50 @@ fn listed_emergencies_only_sends_nothing_the_spec_does_not_list() {
     assert!(!n.is_active(&EmcyDefault::for_event(EmcyEvent::CanPassive, &[])));
     n.on_bus_state(BusState::Active, 3_000);
     assert_eq!(emergencies(&frames(&mut n, 3_000)), Vec::<[u8; 8]>::new(), "no error reset for what was never sent");
+}
+
+/// Operational with TPDO1 (type 255) and RPDO1 both mapping 2000h.
+fn operational(cfg: NodeConfig) -> TestNode {
+    let mut n = node(cfg, &[]);
+    nmt(&mut n, 0x01, ID);
+    frames(&mut n, 0);
+    n
+}
+
+#[test]
+fn by_default_every_write_of_a_mapped_entry_triggers_its_tpdo() {
+    let mut n = operational(NodeConfig::new(ID));
+    assert_eq!(n.write(0x2000, 0, &[7], Side::Device), Ok(()));
+    assert_eq!(tpdo1(&frames(&mut n, 0)), [[7]], "a device write");
+    assert_eq!(n.write(0x2000, 0, &[8], Side::Host), Ok(()));
+    assert_eq!(tpdo1(&frames(&mut n, 0)), [[8]], "a host write");
+    let (result, sent) = download_with(&mut n, 0x2000, 0, &[9]);
+    assert_eq!((result, tpdo1(&sent)), (Ok(()), vec![vec![9]]), "an SDO download");
+    n.on_frame(&CanFrame::data(0x205, &[10]).unwrap(), 0);
+    assert_eq!(tpdo1(&frames(&mut n, 0)), [[10]], "an RPDO");
+    assert_eq!(n.write(0x2001, 0, &[1], Side::Device), Ok(()));
+    assert_eq!(tpdo1(&frames(&mut n, 0)), Vec::<Vec<u8>>::new(), "2001h is not mapped");
+    n.trigger_mapped(0x2000, 0);
+    assert_eq!(tpdo1(&frames(&mut n, 0)), [[10]], "trigger_mapped works with the setting on too");
+}
+
+#[test]
+fn without_tpdo_on_write_only_the_device_triggers_tpdos() {
+    let mut n = operational(NodeConfig { tpdo_on_write: false, ..NodeConfig::new(ID) });
+    assert_eq!(n.write(0x2000, 0, &[7], Side::Device), Ok(()));
+    assert_eq!(n.write(0x2000, 0, &[8], Side::Host), Ok(()));
+    let (result, sent) = download_with(&mut n, 0x2000, 0, &[9]);
+    assert_eq!((result, tpdo1(&sent)), (Ok(()), vec![]), "an SDO download");
+    n.on_frame(&CanFrame::data(0x205, &[10]).unwrap(), 0);
+    assert_eq!(tpdo1(&frames(&mut n, 0)), Vec::<Vec<u8>>::new(), "no write sends TPDO1");
+    assert_eq!(read_u8(&mut n, 0x2000), 10, "though every write took effect");
+    n.trigger_mapped(0x2001, 0);
+    n.trigger_mapped(0x2000, 1);
+    assert_eq!(tpdo1(&frames(&mut n, 0)), Vec::<Vec<u8>>::new(), "2001h and 2000h.1 are not mapped");
+    n.trigger_mapped(0x2000, 0);
+    assert_eq!(tpdo1(&frames(&mut n, 0)), [[10]], "the device's trigger sends the current value");
+    // An invalid TPDO is not triggered.
+    assert_eq!(n.write(0x1800, 1, &(0x8000_0180_u32 + u32::from(ID)).to_le_bytes(), Side::Device), Ok(()));
+    n.trigger_mapped(0x2000, 0);
+    assert_eq!(tpdo1(&frames(&mut n, 0)), Vec::<Vec<u8>>::new());
 }
