@@ -514,6 +514,7 @@ fn node_config(d: &Device, stack: &TokenStream) -> TokenStream {
         None => quote!(None),
     };
     let (restart, bootup, startup) = (object(n.restart_time_object), object(n.bootup_object), object(n.startup_object));
+    let remapping = object(n.remapping_object);
     let (deadlines, combine, auto_save) = (n.rpdo_deadline_monitoring, n.combine_emcy_codes, n.auto_save);
     let (listed_only, tpdo_on_write) = (n.listed_emergencies_only, n.tpdo_on_write);
     quote! {
@@ -521,6 +522,7 @@ fn node_config(d: &Device, stack: &TokenStream) -> TokenStream {
             restart_time_object: #restart,
             bootup_object: #bootup,
             startup_object: #startup,
+            remapping_object: #remapping,
             rpdo_deadlines: #deadlines,
             combine_emcy_codes: #combine,
             auto_save: #auto_save,

@@ -25,7 +25,13 @@ fn the_node_section_becomes_node_config() {
     let code = pretty(generate(&device, &Options::default())).expect("generates");
     let start = code.find("pub const fn node_config").expect("node_config");
     let body = &code[start..start + code[start..].find("\n}").expect("its end")];
-    for field in ["restart_time_object: Some(0x2000)", "rpdo_deadlines: false", "listed_emergencies_only: true", "tpdo_on_write: false"] {
+    for field in [
+        "restart_time_object: Some(0x2000)",
+        "rpdo_deadlines: false",
+        "listed_emergencies_only: true",
+        "tpdo_on_write: false",
+        "remapping_object: Some(0x2004)",
+    ] {
         assert!(body.contains(field), "{field} in\n{body}");
     }
 }

@@ -211,6 +211,10 @@ fn node(out: &mut String, d: &Device) {
             object(n.startup_object, "1 makes the node enter Operational by itself after boot-up", "the node stays pre-operational until an NMT start"),
         ),
         (
+            "remapping_object",
+            object(n.remapping_object, "0 refuses every write of a PDO mapping (SDO abort 0800 0021h)", "PDO mappings are written as CiA 301 alone allows"),
+        ),
+        (
             "rpdo_deadline_monitoring",
             flag(
                 n.rpdo_deadline_monitoring,

@@ -57,12 +57,14 @@ pub struct NodeSettings {
     pub listed_emergencies_only: bool,
     /// A write of an entry a valid TPDO maps triggers the TPDO (else the device does).
     pub tpdo_on_write: bool,
+    /// An UNSIGNED8 object whose value 0 refuses every write of a PDO mapping.
+    pub remapping_object: Option<u16>,
 }
 
 /// Plain CiA 301: no device-specific objects, RPDO deadline monitoring on, emergency
 /// manufacturer bytes not combined, persistent entries saved only through 1010, the CiA 301
 /// emergency for a stack event the spec lists none for, TPDOs triggered by writes of what they
-/// map.
+/// map, PDO mappings writable as CiA 301 alone says.
 impl Default for NodeSettings {
     fn default() -> Self {
         NodeSettings {
@@ -74,14 +76,20 @@ impl Default for NodeSettings {
             auto_save: false,
             listed_emergencies_only: false,
             tpdo_on_write: true,
+            remapping_object: None,
         }
     }
 }
 
 impl NodeSettings {
     /// The settings that name an object, by spec key: the node reads sub 0 of each at run time.
-    pub fn objects(&self) -> [(&'static str, Option<u16>); 3] {
-        [("restart_time_object", self.restart_time_object), ("bootup_object", self.bootup_object), ("startup_object", self.startup_object)]
+    pub fn objects(&self) -> [(&'static str, Option<u16>); 4] {
+        [
+            ("restart_time_object", self.restart_time_object),
+            ("bootup_object", self.bootup_object),
+            ("startup_object", self.startup_object),
+            ("remapping_object", self.remapping_object),
+        ]
     }
 }
 
@@ -91,6 +99,7 @@ pub struct NodeSpans {
     pub restart_time_object: Span,
     pub bootup_object: Span,
     pub startup_object: Span,
+    pub remapping_object: Span,
 }
 
 impl NodeSpans {
@@ -100,6 +109,7 @@ impl NodeSpans {
             "restart_time_object" => self.restart_time_object,
             "bootup_object" => self.bootup_object,
             "startup_object" => self.startup_object,
+            "remapping_object" => self.remapping_object,
             _ => Span::NONE,
         }
     }

@@ -122,6 +122,8 @@ pub struct Node {
     pub listed_emergencies_only: Option<bool>,
     #[serde(default)]
     pub tpdo_on_write: Option<bool>,
+    #[serde(default)]
+    pub remapping_object: Option<Num>,
 }
 
 #[derive(Debug, Deserialize)]

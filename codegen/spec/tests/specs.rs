@@ -151,6 +151,7 @@ fn node_settings_are_what_each_firmware_needs() {
             auto_save: false,
             listed_emergencies_only: false,
             tpdo_on_write: true,
+            remapping_object: None,
         }
     );
     let expected = [
@@ -175,7 +176,13 @@ fn node_settings_are_what_each_firmware_needs() {
             let Some(index) = index else { continue };
             for mode in d.mode_names() {
                 let e = d.object(index, mode).and_then(|o| o.entry(0)).unwrap_or_else(|| panic!("{name}: node.{key} {index:04X} in {mode:?}"));
-                assert!(e.access.readable() && e.access.writable(), "{name}: node.{key} {index:04X} is configurable over CAN");
+                if key == "remapping_object" {
+                    // The switch may be local (CO401GW1 2102h: read-only from CAN, the host sets it).
+                    let settable = e.access.writable() || e.host_access.writable();
+                    assert!(e.access.readable() && settable, "{name}: node.{key} {index:04X} is read over CAN and set by someone");
+                } else {
+                    assert!(e.access.readable() && e.access.writable(), "{name}: node.{key} {index:04X} is configurable over CAN");
+                }
             }
         }
     }
@@ -208,6 +215,7 @@ fn the_fixture_node_section_is_read_whole() {
         rpdo_deadline_monitoring: false,
         listed_emergencies_only: true,
         tpdo_on_write: false,
+        remapping_object: Some(0x2004),
         ..NodeSettings::default()
     };
     assert_eq!(d.node, want);

@@ -32,6 +32,9 @@ pub struct NodeConfig {
     /// writes (SDO, RPDO, device, host). Off where the device decides when its TPDOs go out
     /// (DS401 input rules), through [`Node::trigger_mapped`](crate::node::Node::trigger_mapped).
     pub tpdo_on_write: bool,
+    /// An object whose value 0 refuses every write of a PDO mapping (16xxh, 1Axxh), from any
+    /// side, with SDO abort 0800 0021h (CO401GW1 2102h "Remapping Enabled Info").
+    pub remapping_object: Option<u16>,
 }
 
 impl NodeConfig {
@@ -47,6 +50,7 @@ impl NodeConfig {
             rpdo_deadlines: true,
             listed_emergencies_only: false,
             tpdo_on_write: true,
+            remapping_object: None,
         }
     }
 }

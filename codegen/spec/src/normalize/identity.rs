@@ -55,6 +55,7 @@ pub(super) fn node_settings(cx: &mut Cx<'_>, n: &S<raw::Node>) -> (NodeSettings,
     let (restart_time_object, restart_span) = object(&v.restart_time_object, "restart_time_object");
     let (bootup_object, bootup_span) = object(&v.bootup_object, "bootup_object");
     let (startup_object, startup_span) = object(&v.startup_object, "startup_object");
+    let (remapping_object, remapping_span) = object(&v.remapping_object, "remapping_object");
     let settings = NodeSettings {
         restart_time_object,
         bootup_object,
@@ -64,6 +65,8 @@ pub(super) fn node_settings(cx: &mut Cx<'_>, n: &S<raw::Node>) -> (NodeSettings,
         auto_save: v.auto_save.unwrap_or(defaults.auto_save),
         listed_emergencies_only: v.listed_emergencies_only.unwrap_or(defaults.listed_emergencies_only),
         tpdo_on_write: v.tpdo_on_write.unwrap_or(defaults.tpdo_on_write),
+        remapping_object,
     };
-    (settings, NodeSpans { restart_time_object: restart_span, bootup_object: bootup_span, startup_object: startup_span })
+    let spans = NodeSpans { restart_time_object: restart_span, bootup_object: bootup_span, startup_object: startup_span, remapping_object: remapping_span };
+    (settings, spans)
 }

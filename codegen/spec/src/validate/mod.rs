@@ -8,6 +8,7 @@ mod emcy;
 mod errata;
 mod hardware;
 mod node;
+mod node_remapping;
 mod od;
 mod pdo;
 mod serial;
@@ -39,10 +40,11 @@ pub const RULES: &[Rule] = &[
     Rule { id: "node-object", summary: "a `node` setting names an object that is missing in some mode", check: node::object },
     Rule {
         id: "node-object-type",
-        summary: "a `node` setting names an object that is not a VAR of an unsigned integer type (restart time: UNSIGNED16)",
+        summary: "a `node` setting names an object that is not a VAR of an unsigned integer type (restart time: UNSIGNED16; remapping switch: `node-remapping-type`)",
         check: node::object_type,
     },
     Rule { id: "node-object-access", summary: "a `node` setting names an object that cannot be read (`wo` or `none`)", check: node::object_access },
+    Rule { id: "node-remapping-type", summary: "`node.remapping_object` names an object that is not UNSIGNED8", check: node_remapping::remapping_type },
     Rule { id: "pdo-duplicate", summary: "a PDO number is defined twice in one mode", check: pdo::duplicate },
     Rule { id: "pdo-mapping-target", summary: "a default mapping points at a missing object or sub-index", check: pdo::mapping_target },
     Rule { id: "pdo-mapping-mappable", summary: "a default mapping maps an entry that is not PDO-mappable", check: pdo::mapping_mappable },

@@ -1,7 +1,8 @@
 //! `node:` rules: the objects the node settings name are ones the node can read its setting from.
 //!
-//! The stack reads sub 0 of each named object at run time (boot-up, start-up, bus off) as an
-//! unsigned number of at most 4 bytes, in whichever mode the device runs.
+//! The stack reads sub 0 of each named object at run time (boot-up, start-up, bus off, a PDO
+//! mapping write) as an unsigned number of at most 4 bytes, in whichever mode the device runs.
+//! The remapping switch's type has a rule of its own (`node_remapping`).
 
 use super::hex4;
 use crate::diag::{Diagnostic, Diagnostics};
@@ -17,16 +18,18 @@ fn named(d: &Device) -> impl Iterator<Item = (&'static str, u16, Vec<&Object>)> 
 }
 
 /// ` (in mode `mixed`)` for a definition that exists in some modes only.
-fn in_modes(o: &Object) -> String {
+pub(super) fn in_modes(o: &Object) -> String {
     o.modes.as_ref().map_or(String::new(), |m| format!(" (in mode {})", m.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ")))
 }
 
 /// The data types a setting's object may have: the restart time is frenzel+berg's UNSIGNED16
 /// in ms (2180h); a switch may be any unsigned integer the stack reads whole (at most 32 bits).
-fn allowed_types(key: &str) -> &'static [DataType] {
+/// `None`: a rule of its own checks the type (`remapping_object`: `node-remapping-type`).
+fn allowed_types(key: &str) -> Option<&'static [DataType]> {
     match key {
-        "restart_time_object" => &[DataType::Unsigned16],
-        _ => &[DataType::Unsigned8, DataType::Unsigned16, DataType::Unsigned24, DataType::Unsigned32],
+        "restart_time_object" => Some(&[DataType::Unsigned16]),
+        "remapping_object" => None,
+        _ => Some(&[DataType::Unsigned8, DataType::Unsigned16, DataType::Unsigned24, DataType::Unsigned32]),
     }
 }
 
@@ -71,7 +74,7 @@ pub fn object_type(d: &Device, diags: &mut Diagnostics) {
                 );
                 continue;
             };
-            let allowed = allowed_types(key);
+            let Some(allowed) = allowed_types(key) else { continue };
             if !allowed.contains(&e.data_type) {
                 let rule = if key == "restart_time_object" {
                     "the bus-off restart time must be an UNSIGNED16 (ms)".to_string()

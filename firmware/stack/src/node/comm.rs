@@ -7,11 +7,13 @@
 //! - writing a mapping while the PDO is valid, or a mapping entry while sub 0 is not 0:
 //!   0800 0022h (not in the present device state), since the same write succeeds once the
 //!   master has followed the remapping procedure;
+//! - writing a mapping while the remapping object (`remapping_object`) reads 0: 0800 0021h
+//!   (local control), from any side: the device, not the master, disabled remapping;
 //! - two consumer entries for one producer: 0604 0043h (general parameter incompatibility);
 //!   more producers than the node can monitor: 0604 0047h.
 
-use super::Core;
 use super::le_u32;
+use super::{Core, read_u32};
 use crate::heartbeat::{Consumer, MAX_CONSUMED};
 use crate::od::{NodeDictionary, SdoAbort, Side};
 use crate::pdo::slot::mapping_words;
@@ -72,6 +74,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     /// The CiA 301 remapping procedure: invalidate the PDO, set sub 0 to 0, write the
     /// entries, set sub 0 to their number.
     fn check_pdo_mapping(&mut self, dir: Dir, index: u16, sub: u8, value: u32, side: Side) -> Result<(), SdoAbort> {
+        self.check_remapping_enabled()?;
         if side == Side::Device {
             return Ok(());
         }
@@ -91,6 +94,14 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
             check_entry(&self.od, value, dir)?;
         }
         Ok(())
+    }
+
+    /// Whether any side may write a mapping now: not while the remapping object reads 0.
+    fn check_remapping_enabled(&mut self) -> Result<(), SdoAbort> {
+        match self.cfg.remapping_object {
+            Some(index) if read_u32(&mut self.od, index, 0) == Some(0) => Err(SdoAbort::DataTransferLocal),
+            _ => Ok(()),
+        }
     }
 
     fn check_consumer(&mut self, sub: u8, value: u32) -> Result<(), SdoAbort> {

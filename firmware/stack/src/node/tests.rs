@@ -6,7 +6,8 @@ use super::{BusState, Node, NodeConfig, NodeEvent};
 use crate::emcy::{EmcyDefault, EmcyEvent, Reaction};
 use crate::frame::CanFrame;
 use crate::od::{
-    Access, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NoAppObjects, NodeDictionary, Side, Storage,
+    Access, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NoAppObjects, NodeDictionary, SdoAbort, Side,
+    Storage,
 };
 use crate::store::NoStore;
 use crate::value::OdValue;
@@ -31,7 +32,7 @@ const fn entry(index: u16, sub: u8, data_type: DataType, access: Access) -> Entr
         last_sub: sub,
         limits: 0,
         kind: EntryKind::new(data_type, access),
-        flags: if index == 0x2000 { flags.pdo_mappable() } else { flags },
+        flags: if index == 0x2000 || index == 0x2001 { flags.pdo_mappable() } else { flags },
     }
 }
 
@@ -199,13 +200,21 @@ fn download_with(n: &mut TestNode, index: u16, sub: u8, value: &[u8]) -> (Result
     (result, others)
 }
 
+fn download(n: &mut TestNode, index: u16, sub: u8, value: &[u8]) -> Result<(), u32> {
+    download_with(n, index, sub, value).0
+}
+
 /// The payloads of the TPDO1 frames (0x185) among `frames`.
 fn tpdo1(frames: &[CanFrame]) -> Vec<Vec<u8>> {
     frames.iter().filter(|f| f.id == 0x180 + u16::from(ID)).map(|f| f.payload().to_vec()).collect()
 }
 
 fn read_u8(n: &mut TestNode, index: u16) -> u8 {
-    super::read_u32(n.od_mut(), index, 0).unwrap() as u8
+    read(n, index, 0) as u8
+}
+
+fn read(n: &mut TestNode, index: u16, sub: u8) -> u32 {
+    super::read_u32(n.od_mut(), index, sub).unwrap()
 }
 
 #[test]
@@ -378,4 +387,49 @@ fn without_tpdo_on_write_only_the_device_triggers_tpdos() {
     assert_eq!(n.write(0x1800, 1, &(0x8000_0180_u32 + u32::from(ID)).to_le_bytes(), Side::Device), Ok(()));
     n.trigger_mapped(0x2000, 0);
     assert_eq!(tpdo1(&frames(&mut n, 0)), Vec::<Vec<u8>>::new());
+}
+
+/// The mapping writes of the CiA 301 remapping procedure, with sub 0 as a byte.
+const MAPPING_WRITES: [(u16, u8, u32); 4] = [(0x1A00, 0, 0), (0x1A00, 1, 0x2001_0008), (0x1600, 0, 0), (0x1600, 1, 0x2001_0008)];
+
+fn value_of(sub: u8, value: u32) -> Vec<u8> {
+    if sub == 0 { vec![value as u8] } else { value.to_le_bytes().to_vec() }
+}
+
+#[test]
+fn while_the_remapping_object_reads_0_no_side_writes_a_mapping() {
+    let mut n = node(NodeConfig { remapping_object: Some(0x2102), ..NodeConfig::new(ID) }, &[]);
+    assert_eq!(n.write(0x2102, 0, &[0], Side::Host), Ok(()));
+    // The procedure's first step is allowed: communication parameters are no mapping.
+    assert_eq!(download(&mut n, 0x1800, 1, &(0x8000_0180 + u32::from(ID)).to_le_bytes()), Ok(()));
+    assert_eq!(download(&mut n, 0x1400, 1, &(0x8000_0200 + u32::from(ID)).to_le_bytes()), Ok(()));
+    for (index, sub, value) in MAPPING_WRITES {
+        let data = value_of(sub, value);
+        assert_eq!(download(&mut n, index, sub, &data), Err(0x0800_0021), "{index:04X}.{sub} over SDO");
+        assert_eq!(n.write(index, sub, &data, Side::Host), Err(SdoAbort::DataTransferLocal), "{index:04X}.{sub} by the host");
+        assert_eq!(n.write(index, sub, &data, Side::Device), Err(SdoAbort::DataTransferLocal), "{index:04X}.{sub} by the device");
+    }
+    assert_eq!((read(&mut n, 0x1A00, 0), read(&mut n, 0x1A00, 1)), (1, 0x2000_0008), "TPDO1 mapping unchanged");
+    assert_eq!((read(&mut n, 0x1600, 0), read(&mut n, 0x1600, 1)), (1, 0x2000_0008), "RPDO1 mapping unchanged");
+    // Any non-zero value enables remapping again: the procedure goes through.
+    assert_eq!(n.write(0x2102, 0, &[2], Side::Host), Ok(()));
+    for (index, sub, value) in MAPPING_WRITES {
+        assert_eq!(download(&mut n, index, sub, &value_of(sub, value)), Ok(()), "{index:04X}.{sub}");
+    }
+    assert_eq!(download(&mut n, 0x1A00, 0, &[1]), Ok(()));
+    assert_eq!(download(&mut n, 0x1800, 1, &(0x180 + u32::from(ID)).to_le_bytes()), Ok(()));
+    nmt(&mut n, 0x01, ID);
+    frames(&mut n, 0);
+    assert_eq!(n.write(0x2001, 0, &[0x42], Side::Device), Ok(()));
+    assert_eq!(tpdo1(&frames(&mut n, 0)), [[0x42]], "TPDO1 now maps 2001h");
+}
+
+#[test]
+fn without_a_remapping_object_mappings_follow_cia_301_alone() {
+    let mut n = node(NodeConfig::new(ID), &[]);
+    assert_eq!(n.write(0x2102, 0, &[0], Side::Host), Ok(()));
+    assert_eq!(download(&mut n, 0x1A00, 0, &[0]), Err(SdoAbort::DataTransferState.code()), "TPDO1 is valid");
+    assert_eq!(n.write(0x1A00, 1, &0x2001_0008_u32.to_le_bytes(), Side::Device), Ok(()), "the device may");
+    assert_eq!(download(&mut n, 0x1800, 1, &(0x8000_0180 + u32::from(ID)).to_le_bytes()), Ok(()));
+    assert_eq!(download(&mut n, 0x1A00, 0, &[0]), Ok(()));
 }
