@@ -64,7 +64,9 @@ enum Cmd {
     /// Lines on standard input are console commands for the first node, answered on standard
     /// output with `coforge sim: ok ...` or `coforge sim: error ...`. CO401Memory1 takes
     /// `supply <mV>` (the board's supply reading), `corrupt <bank 1|2> <offset> <value>` (one
-    /// EEPROM byte, offsets as in the bank layout of coforge-storage) and `outputs`.
+    /// EEPROM byte, offsets as in the bank layout of coforge-storage) and `outputs`. CO401GW1
+    /// takes `in <bits>` (bit n: input INn active), `emy0 on|off`, `emy1 on|off`, `enable
+    /// [alt]` (what the host's 02 00 / 02 81 does) and `pins` (outputs, LEDs, watchdog).
     Sim {
         /// Device crate name: co401memory1, co401gw1, cr3101 or canopenia.
         device: String,
@@ -84,6 +86,10 @@ enum Cmd {
         /// one; the address is printed). pyserial: `serial_for_url('socket://127.0.0.1:PORT')`.
         #[arg(long)]
         serial: Option<u16>,
+        /// Enable the CAN side at start, as the serial host would (CO401GW1 starts with CAN
+        /// off until its host enables it; mode digital_alt uses the alternate command).
+        #[arg(long)]
+        enable_can: bool,
         /// Run this many nodes, with node-IDs node_id, node_id + 1, ...
         #[arg(long, default_value_t = 1)]
         nodes: u8,
@@ -158,10 +164,11 @@ struct SimArgs<'a> {
     count: u8,
     seconds: Option<u64>,
     serial: Option<u16>,
+    enable_can: bool,
 }
 
 fn sim(args: SimArgs<'_>) -> Result<ExitCode, String> {
-    let SimArgs { device, first_id, port, mode, store, count, seconds, serial } = args;
+    let SimArgs { device, first_id, port, mode, store, count, seconds, serial, enable_can } = args;
     use coforge_sim::devices::{DeviceKind, StoreAt};
     let kind = DeviceKind::find(device)?;
     if count == 0 || u16::from(first_id) + u16::from(count) - 1 > 127 {
@@ -175,6 +182,12 @@ fn sim(args: SimArgs<'_>) -> Result<ExitCode, String> {
     let hub = coforge_sim::hub::Hub::bind(("127.0.0.1", port)).map_err(|e| format!("cannot listen on port {port}: {e}"))?;
     let has_serial = nodes.first_mut().is_some_and(|n| n.host_port().is_some());
     let running = coforge_sim::runner::spawn(&hub, nodes);
+    if enable_can {
+        let command = if mode == Some("digital_alt") { "enable alt" } else { "enable" };
+        for node in 0..usize::from(count) {
+            running.control(node, command).map_err(|why| format!("--enable-can: {why}"))?;
+        }
+    }
     if let Some(serial_port) = serial {
         if !has_serial {
             return Err(format!("{} has no serial host interface", kind.name));
@@ -271,8 +284,8 @@ fn hub(port: u16, adapters: &[String], seconds: Option<u64>) -> Result<ExitCode,
 fn run(cmd: Cmd) -> Result<ExitCode, String> {
     match cmd {
         Cmd::Hub { port, connect, seconds } => hub(port, &connect, seconds),
-        Cmd::Sim { device, node_id, port, mode, store, nodes, seconds, serial } => {
-            sim(SimArgs { device: &device, first_id: node_id, port, mode: mode.as_deref(), store, count: nodes, seconds, serial })
+        Cmd::Sim { device, node_id, port, mode, store, nodes, seconds, serial, enable_can } => {
+            sim(SimArgs { device: &device, first_id: node_id, port, mode: mode.as_deref(), store, count: nodes, seconds, serial, enable_can })
         }
         Cmd::Check { specs } => {
             let mut failed = 0;

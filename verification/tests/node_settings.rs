@@ -4,16 +4,19 @@
 
 use coforge_stack::frame::CanFrame;
 use coforge_stack::node::{BusState, NodeConfig, read_u32};
-use coforge_stack::od::{NoAppObjects, SdoAbort, Side};
+use co401gw1::IoImage;
+use co401gw1::app::Typed;
+use coforge_stack::od::{SdoAbort, Side};
 use coforge_stack::store::NoStore;
 
 const ID: u8 = 5;
 
-type Gw1 = co401gw1::Node<NoAppObjects, NoStore>;
+/// The chip's dictionary over its own process image (6000h..6320h are app-backed).
+type Gw1 = co401gw1::Node<Typed<IoImage>, NoStore>;
 
 /// A started CO401GW1 node in its first mode with `cfg`, its boot-up taken.
 fn gw1(cfg: impl FnOnce(NodeConfig) -> NodeConfig) -> Gw1 {
-    let od = co401gw1::Od::new(co401gw1::Mode::ALL[0], ID, NoAppObjects);
+    let od = co401gw1::Od::new(co401gw1::Mode::ALL[0], ID, Typed(IoImage::default()));
     let mut n: Gw1 = coforge_stack::node::Node::new(od, NoStore, cfg(co401gw1::node_config(ID)));
     n.start(0);
     drain(&mut n, 0);

@@ -160,10 +160,21 @@ fn node_settings_are_what_each_firmware_needs() {
             "co401memory1.yaml",
             NodeSettings { restart_time_object: Some(0x2180), combine_emcy_codes: true, rpdo_deadline_monitoring: false, ..NodeSettings::default() },
         ),
-        // CAN restart time 2180h, boot-up message switch 2110h; no RPDO deadlines (GW1-13).
+        // CAN restart time 2180h, boot-up message switch 2110h; no RPDO deadlines (GW1-13); CO40xx
+        // codes ORed; only the datasheet's emergencies (GW1-59); DS401 events (GW1-61); 2102h
+        // gates remapping (GW1-60).
         (
             "co401gw1.yaml",
-            NodeSettings { restart_time_object: Some(0x2180), bootup_object: Some(0x2110), rpdo_deadline_monitoring: false, ..NodeSettings::default() },
+            NodeSettings {
+                restart_time_object: Some(0x2180),
+                bootup_object: Some(0x2110),
+                rpdo_deadline_monitoring: false,
+                combine_emcy_codes: true,
+                listed_emergencies_only: true,
+                tpdo_on_write: false,
+                remapping_object: Some(0x2102),
+                ..NodeSettings::default()
+            },
         ),
         // 20F4h "CANopen StartUp mode"; all parameters are saved automatically.
         ("cr3101.yaml", NodeSettings { startup_object: Some(0x20F4), auto_save: true, ..NodeSettings::default() }),

@@ -3,6 +3,7 @@
 
 use crate::app::RamApp;
 use crate::storage::Eeprom;
+use co401gw1::Gw1;
 use co401memory1::{FixedBoard, Memory1};
 use coforge_stack::device::{Assemble, AssembleError, Device, MemoryRequest, NodeAccess};
 use coforge_stack::emcy::EmcyDefault;
@@ -14,7 +15,7 @@ use std::path::PathBuf;
 /// Every device, by crate name.
 pub const DEVICES: &[DeviceKind] = &[
     DeviceKind::of::<Memory1<Eeprom, FixedBoard>>("co401memory1"),
-    DeviceKind::of::<co401gw1::Node<RamApp, BlockStore<Eeprom>>>("co401gw1"),
+    DeviceKind::of::<Gw1<co401gw1::FixedBoard, BlockStore<Eeprom>>>("co401gw1"),
     DeviceKind::of::<cr3101::Node<RamApp, BlockStore<Eeprom>>>("cr3101"),
     DeviceKind::of::<canopenia::Node<RamApp, BlockStore<Eeprom>>>("canopenia"),
 ];

@@ -5,6 +5,7 @@
 //! - [`hub`]: the bus, a TCP SLCAN listener plus in-process [`hub::Port`]s;
 //! - [`devices`]: the coforge devices by name, built and driven through the device contract;
 //! - [`memory1`]: CO401Memory1's console commands (supply, corrupt, outputs);
+//! - [`gw1`]: CO401GW1's console commands (input and emergency pins, enable, pins);
 //! - [`runner`]: real-time nodes on a hub, one thread for all of them;
 //! - [`serial`]: a device's serial host interface on a TCP port;
 //! - [`vbus`]: a deterministic in-process bus on a virtual clock, for tests;
@@ -15,6 +16,7 @@
 
 pub mod app;
 pub mod devices;
+pub mod gw1;
 pub mod hub;
 pub mod memory1;
 pub mod runner;

@@ -70,8 +70,9 @@ impl VirtualBus {
         }
     }
 
-    /// Polls every node until none has anything left to send.
-    fn settle(&mut self) {
+    /// Polls every node until none has anything left to send (also after a test acted on a
+    /// node directly, through its console or its host port).
+    pub fn settle(&mut self) {
         loop {
             let mut sent = false;
             for i in 0..self.nodes.len() {

@@ -14,8 +14,18 @@ fn node(device: &str) -> Box<dyn SimDevice> {
     DeviceKind::find(device).unwrap().create(None, ID, &StoreAt::Memory).unwrap()
 }
 
-fn bus(device: &str) -> VirtualBus {
+/// A bus with `device` on it, its CAN side enabled (CO401GW1 waits for its host's enable).
+fn started(device: &str) -> VirtualBus {
     let mut bus = VirtualBus::new(vec![node(device)]);
+    if device == "co401gw1" {
+        bus.nodes[0].console("enable").unwrap();
+        bus.settle();
+    }
+    bus
+}
+
+fn bus(device: &str) -> VirtualBus {
+    let mut bus = started(device);
     let boot = bus.drain();
     assert_eq!(boot, vec![CanFrame::data(0x705, &[0]).unwrap()], "boot-up message");
     bus
@@ -172,12 +182,13 @@ fn tpdo_remapping_and_transmission_types() {
     download(&mut bus, 0x1800, 1, &cob.to_le_bytes()).unwrap();
     nmt(&mut bus, 0x01);
     bus.drain();
-    bus.nodes[0].node_mut().write(0x6000, 1, &[0xAB], coforge_stack::od::Side::Device).unwrap();
+    // 6000h.2: 6000h.1 is the chip's IN0..IN7 (hardware inputs enabled).
+    bus.nodes[0].node_mut().write(0x6000, 2, &[0xAB], coforge_stack::od::Side::Device).unwrap();
     let sync = frame(0x080, &[]);
     bus.send(sync);
     assert!(bus.drain().is_empty(), "first SYNC of two");
     bus.send(sync);
-    assert_eq!(bus.drain(), vec![frame(0x185, &[0xAB, 0x00])]);
+    assert_eq!(bus.drain(), vec![frame(0x185, &[0x00, 0xAB])]);
 }
 
 #[test]
@@ -229,12 +240,13 @@ fn sync_cycle_monitoring_from_1006() {
     assert_eq!(emcy_frames(&mut bus), vec![[0, 0, 0, 0, 0, 0, 0, 0]], "the next SYNC resets the error");
 }
 
-/// CO401GW1 with CiA 301 4.2 RPDO deadline monitoring switched on (the chip itself has it off,
-/// erratum GW1-13), to check the stack's monitor.
+/// CO401GW1's dictionary as a plain node with CiA 301 4.2 RPDO deadline monitoring switched on
+/// and its CiA 301 emergency (the chip has neither: errata GW1-13, GW1-59), to check the
+/// stack's monitor.
 fn gw1_with_rpdo_deadlines() -> Box<dyn SimDevice> {
     use coforge_sim::app::RamApp;
     use coforge_stack::store::NoStore;
-    let config = coforge_stack::node::NodeConfig { rpdo_deadlines: true, ..co401gw1::node_config(ID) };
+    let config = coforge_stack::node::NodeConfig { rpdo_deadlines: true, listed_emergencies_only: false, ..co401gw1::node_config(ID) };
     let od = co401gw1::Od::new(co401gw1::Mode::ALL[0], ID, RamApp::default());
     let node: co401gw1::Node<RamApp, NoStore> = coforge_stack::node::Node::new(od, NoStore, config);
     Box::new(node)
@@ -261,7 +273,7 @@ fn rpdo_deadline_monitoring_from_its_event_timer() {
 #[test]
 fn ds301_4_0_devices_do_not_monitor_rpdo_deadlines() {
     for device in ["co401gw1", "co401memory1"] {
-        let mut bus = VirtualBus::new(vec![node(device)]);
+        let mut bus = started(device);
         bus.drain();
         download(&mut bus, 0x1400, 5, &50_u16.to_le_bytes()).unwrap();
         nmt(&mut bus, 0x01);
@@ -325,6 +337,7 @@ fn timers_near_the_end_of_the_clock_do_not_overflow() {
     let mut n = node("co401gw1");
     let t = u64::MAX - 1_000;
     n.start(t);
+    n.console("enable").unwrap();
     n.node_mut().write(0x1017, 0, &100_u16.to_le_bytes(), Side::Bus).unwrap();
     n.node_mut().write(0x1800, 5, &10_u16.to_le_bytes(), Side::Bus).unwrap();
     n.node_mut().write(0x1400, 5, &10_u16.to_le_bytes(), Side::Bus).unwrap();
