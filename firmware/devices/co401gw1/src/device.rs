@@ -356,18 +356,28 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         }
     }
 
-    /// The node's events: NMT resets re-apply the pins and the host's configuration, and the
-    /// rest become unsolicited telegrams as 2E01h enables them; all go on to the runtime.
+    /// The node's events: NMT resets re-apply the pins and the host's configuration first
+    /// (the stack has reloaded the dictionary before any of its events is read, so the NMT
+    /// command's report must see 2E01h as the host set it), then the rest become unsolicited
+    /// telegrams as 2E01h enables them; all go on to the runtime.
     fn take_node_events(&mut self) {
-        let mut report_state = false;
+        let mut events: heapless::Vec<NodeEvent, EVENTS> = heapless::Vec::new();
         while let Some(event) = self.node.take_event() {
-            let control = self.node.od().gateway_transfer_control.clone();
+            if events.is_full() {
+                events.remove(0);
+            }
+            let _ = events.push(event);
+        }
+        if events.contains(&NodeEvent::ResetApplication) {
+            self.node.od_mut().app.outputs = [0; IMAGE];
+        }
+        if events.iter().any(|e| matches!(e, NodeEvent::ResetApplication | NodeEvent::ResetCommunication)) {
+            self.after_reset();
+        }
+        let control = self.node.od().gateway_transfer_control.clone();
+        let mut report_state = false;
+        for event in events {
             match event {
-                NodeEvent::ResetApplication => {
-                    self.node.od_mut().app.outputs = [0; IMAGE];
-                    self.after_reset();
-                }
-                NodeEvent::ResetCommunication => self.after_reset(),
                 NodeEvent::StateChanged(_) | NodeEvent::NmtReceived(_) => report_state |= control.auto_send_nmt_state != 0,
                 NodeEvent::RpdoReceived(p) => {
                     if control.auto_send_received_pdo_data & 1 << p.min(15) != 0 {
@@ -379,7 +389,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
                         self.send_host(&emergency_report(frame));
                     }
                 }
-                NodeEvent::RestartController => {}
+                NodeEvent::ResetApplication | NodeEvent::ResetCommunication | NodeEvent::RestartController => {}
             }
             if self.events.is_full() {
                 self.events.pop_front();

@@ -314,6 +314,17 @@ fn critical_errors_force_the_outputs() {
 }
 
 #[test]
+fn an_nmt_reset_is_reported_with_the_hosts_2e01() {
+    let mut rig = Rig::boot(NODE as u8, true);
+    assert_eq!(rig.command(&[0x20, 0x04, 0x01, 0x2E, 0x02, 0x01]), [0x20, 0x00]);
+    rig.command(&[0x02, 0x00]);
+    // Reset node reloads 2E01h before the chip sees the NMT command: it is reported anyway.
+    rig.frame(0x000, &[0x81, NODE as u8]);
+    assert_eq!(rig.take_host(), [0x50, 0x01, 0x7F]);
+    assert_eq!(rig.chip.node().od().gateway_transfer_control.auto_send_nmt_state, 1);
+}
+
+#[test]
 fn host_configuration_survives_nmt_resets() {
     let mut rig = Rig::boot(NODE as u8, true);
     assert_eq!(rig.command(&[0x20, 0x07, 0x18, 0x10, 0x04, 0x78, 0x56, 0x34, 0x12]), [0x20, 0x00]);
