@@ -138,6 +138,10 @@ pub struct Node<D, S, const N: usize, const P: usize> {
 }
 
 impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S, N, P> {
+    /// Empty queues as constants: all-zero values the compiler clears in one go.
+    const NO_FRAMES: Ring<CanFrame, TX_QUEUE> = Ring::new(CanFrame { id: 0, rtr: false, dlc: 0, data: [0; 8] });
+    const NO_EVENTS: Ring<NodeEvent, EVENTS> = Ring::new(NodeEvent::ResetApplication);
+
     /// A node that has not booted yet; call [`Node::start`].
     pub fn new(od: D, store: S, cfg: NodeConfig) -> Self {
         let mut sdo = SdoServer::new();
@@ -152,8 +156,8 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
             powered: false,
             can_enabled: false,
             now_us: 0,
-            tx: Ring::new(CanFrame { id: 0, rtr: false, dlc: 0, data: [0; 8] }),
-            events: Ring::new(NodeEvent::ResetApplication),
+            tx: Self::NO_FRAMES,
+            events: Self::NO_EVENTS,
             tx_overflows: 0,
             emcy: if cfg.combine_emcy_codes { EmcyProducer::combining() } else { EmcyProducer::new() },
             emcy_cob: None,
