@@ -2,10 +2,10 @@
 //! and PDOs, with each setting switched on and off explicitly (whatever its spec chooses), so
 //! the difference is the setting's alone.
 
-use coforge_stack::frame::CanFrame;
-use coforge_stack::node::{BusState, NodeConfig, read_u32};
 use co401gw1::IoImage;
 use co401gw1::app::Typed;
+use coforge_stack::frame::CanFrame;
+use coforge_stack::node::{BusState, NodeConfig, read_u32};
 use coforge_stack::od::{SdoAbort, Side};
 use coforge_stack::store::NoStore;
 
