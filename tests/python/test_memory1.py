@@ -25,16 +25,15 @@ consequence (an emergency), not for the console's answer.
 
 import os
 import pathlib
-import queue
 import re
 import subprocess
 import tempfile
-import threading
 import time
 import types
 
 import can
 from bus import Recorder
+from simproc import SimProcess
 import canopen
 import pytest
 import serial
@@ -182,17 +181,12 @@ def od():
 class Sim:
     def __init__(self, od):
         self.node_id = NODE_ID
-        self.stderr = tempfile.TemporaryFile()
         args = [COFORGE, "sim", "co401memory1", "--node-id", str(NODE_ID), "--port", "0", "--serial", "0"]
-        self.proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.stderr, text=True, bufsize=1)
-        # stdout is read by a thread: banner lines and console answers arrive in one queue.
-        self.lines = queue.Queue()
-        self.reader = threading.Thread(target=self._read_stdout, daemon=True)
-        self.reader.start()
+        self.sim = SimProcess(args)
         self.net = self.serial = None
         try:
-            serial_url = self._banner(r"serial host on (socket://\S+)")
-            can_url = self._banner(rf"co401memory1 node-ID {NODE_ID} on slcan (socket://\S+)")
+            serial_url = self.sim.banner(r"serial host on (socket://\S+)")
+            can_url = self.sim.banner(rf"co401memory1 node-ID {NODE_ID} on slcan (socket://\S+)")
             self.net = canopen.Network()
             self.net.NOTIFIER_CYCLE = 0.05
             self.rec = Recorder()
@@ -206,37 +200,10 @@ class Sim:
             self.close()
             raise
 
-    def _read_stdout(self):
-        for line in self.proc.stdout:
-            self.lines.put(line.rstrip("\n"))
-
-    def _line(self, timeout):
-        try:
-            return self.lines.get(timeout=timeout)
-        except queue.Empty:
-            raise AssertionError(f"coforge sim printed nothing within {timeout} s{self._stderr_note()}") from None
-
-    def _banner(self, pattern, timeout=20.0):
-        line = self._line(timeout)
-        m = re.search(pattern, line)
-        assert m, f"unexpected banner line {line!r} (wanted {pattern!r})"
-        return m.group(1)
-
-    def _stderr_note(self):
-        self.stderr.seek(0)
-        err = self.stderr.read().decode(errors="replace")
-        return f"; stderr: {err}" if err else ""
-
     def console(self, command, timeout=5.0):
-        """Runs a console command; returns the text after 'coforge sim: ok '."""
-        self.proc.stdin.write(command + "\n")
-        self.proc.stdin.flush()
-        line = self._line(timeout)
-        assert line.startswith("coforge sim: ok "), f"console {command!r}: {line!r}"
-        return line[len("coforge sim: ok ") :]
+        return self.sim.console(command, timeout)
 
     def close(self):
-        exited = self.proc.poll()
         try:
             with pytest.MonkeyPatch.context() as mp:
                 # pyserial's socket:// close() sleeps 0.3 s "in case of quick reconnects".
@@ -246,17 +213,7 @@ class Sim:
                 if self.net is not None:
                     self.net.disconnect()
         finally:
-            self.proc.kill()
-            self.proc.wait(timeout=10)
-            self.reader.join(timeout=5)
-            for f in (self.proc.stdin, self.proc.stdout):
-                try:
-                    f.close()
-                except OSError:
-                    pass
-            note = self._stderr_note()
-            self.stderr.close()
-        assert exited is None, f"coforge sim exited by itself with {exited}{note}"
+            self.sim.stop()
 
     # CANopen helpers -------------------------------------------------------------------------
 
