@@ -1,12 +1,17 @@
-"""A `coforge sim` process as the device suites drive it: its stdout read by a thread (banner
-lines and console answers arrive in one queue), console commands on stdin, and its stderr kept
-for failure messages. The suites build their own CANopen and serial clients on top."""
+"""What the device suites share: a `coforge sim` process (its stdout read by a thread, banner
+lines and console answers arriving in one queue; console commands on stdin; its stderr kept for
+failure messages) and the host end of a device's serial line. The suites add their CANopen
+clients and their protocol's framing on top."""
 
 import queue
 import re
+import socket
 import subprocess
 import tempfile
 import threading
+import time
+
+import serial
 
 
 class SimProcess:
@@ -61,3 +66,34 @@ class SimProcess:
         note = self.stderr_note()
         self.stderr.close()
         assert exited is None, f"coforge sim exited by itself with {exited}{note}"
+
+
+class SerialLine:
+    """The host end of a simulated device's serial line (`--serial`): a pyserial `socket://`
+    port, each write sent at once, reads bounded by a deadline. The suites add their
+    protocol's framing on top."""
+
+    def __init__(self, url):
+        self.port = serial.serial_for_url(url, timeout=0.1)
+        sock = getattr(self.port, "_socket", None)
+        if sock is not None:
+            # Each write goes out at once: pauses on the line are the ones the test makes.
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+
+    def close(self):
+        self.port.close()
+
+    def send(self, data):
+        self.port.write(data)
+        self.port.flush()
+
+    def _read(self, n, deadline):
+        """Up to `n` bytes, whatever arrived by `deadline` (time.monotonic())."""
+        buf = b""
+        while len(buf) < n:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                break
+            self.port.timeout = left
+            buf += self.port.read(n - len(buf))
+        return buf

@@ -34,10 +34,9 @@ import time
 import types
 
 from bus import Recorder
-from simproc import SimProcess
+from simproc import SerialLine, SimProcess
 import canopen
 import pytest
-import serial
 from canopen.sdo.exceptions import SdoAbortedError, SdoCommunicationError
 from serial.urlhandler import protocol_socket
 
@@ -98,37 +97,16 @@ def eventually(fn, timeout=WAIT):
 # --------------------------------------------------------------------------------------------
 
 
-class Host:
+class Host(SerialLine):
     """The host side of the gateway protocol. Until the host has enabled CAN the chip sends
     `01 00` every 250 ms; those telegrams are collected in `bootups` (with their arrival time)
     and skipped by `answer`/`silent`. After `enabled = True` a `01 00` is an unexpected
     telegram like any other."""
 
     def __init__(self, url):
-        self.port = serial.serial_for_url(url, timeout=0.1)
-        sock = getattr(self.port, "_socket", None)
-        if sock is not None:
-            # Each write goes out at once: pauses on the line are the ones the test makes.
-            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        super().__init__(url)
         self.enabled = False
         self.bootups = []
-
-    def close(self):
-        self.port.close()
-
-    def send(self, data):
-        self.port.write(data)
-        self.port.flush()
-
-    def _read(self, n, deadline):
-        buf = b""
-        while len(buf) < n:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                break
-            self.port.timeout = left
-            buf += self.port.read(n - len(buf))
-        return buf
 
     def telegram(self, timeout):
         """One telegram from the chip (command, DataLen, data), or None."""

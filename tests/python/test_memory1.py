@@ -33,10 +33,9 @@ import types
 
 import can
 from bus import Recorder
-from simproc import SimProcess
+from simproc import SerialLine, SimProcess
 import canopen
 import pytest
-import serial
 from canopen.sdo.exceptions import SdoAbortedError
 from serial.urlhandler import protocol_socket
 
@@ -107,27 +106,10 @@ def eeprom_offset(index, sub):
 # --------------------------------------------------------------------------------------------
 
 
-class SerialHost:
+class SerialHost(SerialLine):
     def __init__(self, url):
-        self.port = serial.serial_for_url(url, timeout=0.1)
+        super().__init__(url)
         self.log = []  # (request, answer) of every xfer, as hex text
-
-    def close(self):
-        self.port.close()
-
-    def send(self, data):
-        self.port.write(data)
-        self.port.flush()
-
-    def _read(self, n, deadline):
-        buf = b""
-        while len(buf) < n:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                break
-            self.port.timeout = left
-            buf += self.port.read(n - len(buf))
-        return buf
 
     def answer(self, timeout=2.0):
         """One frame from the device (command byte, then LEN data bytes), or None."""
