@@ -134,14 +134,17 @@ fn drive<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize>(mut n
 /// Operational with TPDO1 and TPDO2 valid. Shared by the criterion bench and the callgrind
 /// example so both measure the same work.
 pub mod requests {
-    use super::{BlockStore, CanFrame, NODE_ID, NoAppObjects, RamEeprom, Store};
+    use super::{BlockStore, CanFrame, NODE_ID, RamEeprom, Store};
+    use co401gw1::IoImage;
+    use co401gw1::app::Typed;
     use coforge_stack::od::Side;
 
-    pub type GwNode = co401gw1::Node<NoAppObjects, Store>;
+    /// The chip's node over its process image (the PDOs map 6000h and 6200h, which it owns).
+    pub type GwNode = co401gw1::Node<Typed<IoImage>, Store>;
 
     /// A started node; TPDO1 and TPDO2 use `transmission_type`.
     pub fn node(transmission_type: u8) -> GwNode {
-        let mut node = GwNode::of_dictionary(co401gw1::Mode::Mixed, NODE_ID, NoAppObjects, BlockStore::new(RamEeprom::new(), 0));
+        let mut node = GwNode::of_dictionary(co401gw1::Mode::Mixed, NODE_ID, Typed(IoImage::default()), BlockStore::new(RamEeprom::new(), 0));
         node.start(0);
         for index in [0x1800_u16, 0x1801] {
             let _ = node.write(index, 2, &[transmission_type], Side::Device);
