@@ -62,6 +62,7 @@ pub enum BusState {
 
 /// What the device code may want to react to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(align(4))]
 pub enum NodeEvent {
     /// NMT reset node: the application's own objects go back to power-on values.
     ResetApplication,
