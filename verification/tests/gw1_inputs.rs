@@ -39,8 +39,11 @@ fn input(with_can: bool) -> impl Strategy<Value = Input> {
     prop_oneof![6 => host, can_weight => can, 1 => time]
 }
 
-/// Every entry's value as the device side reads it, with what may write it.
-fn snapshot(chip: &mut Chip) -> Vec<(u16, u8, Access, HostAccess, Vec<u8>)> {
+/// One entry's value as the device side reads it, with what may write it.
+type Value = (u16, u8, Access, HostAccess, Vec<u8>);
+
+/// Every entry's value.
+fn snapshot(chip: &mut Chip) -> Vec<Value> {
     let entries = chip.node().od().entries();
     let mut out = Vec::new();
     for e in entries.iter().filter(|e| !MAINTAINED.contains(&e.index)) {
@@ -56,7 +59,7 @@ fn snapshot(chip: &mut Chip) -> Vec<(u16, u8, Access, HostAccess, Vec<u8>)> {
 
 /// Runs `inputs` on a fresh chip (mode `mixed`, enabled first if `enabled`); returns the
 /// snapshots before and after.
-fn run(mixed: bool, enabled: bool, inputs: Vec<Input>) -> (Vec<(u16, u8, Access, HostAccess, Vec<u8>)>, Vec<(u16, u8, Access, HostAccess, Vec<u8>)>) {
+fn run(mixed: bool, enabled: bool, inputs: Vec<Input>) -> (Vec<Value>, Vec<Value>) {
     let mut chip: Chip = Gw1::new(FixedBoard::new(NODE as u8, mixed), NoStore);
     chip.start(0);
     if enabled {
