@@ -690,7 +690,10 @@ def packed(entries, values):
     return b"".join(v.to_bytes(bits // 8, "little", signed=v < 0) for (_, _, bits), v in zip(entries, values))
 
 
-@pytest.mark.parametrize("name", ["co401gw1", "canopenia"])
+# CO401GW1 sends a TPDO on DS401 events only (its inputs changing through the masks, erratum
+# GW1-61; tests/python/test_gw1.py), never on an SDO or RPDO write of an output: the tests of
+# "a write of a mapped object is an event" run on CANopenIA.
+@pytest.mark.parametrize("name", ["canopenia"])
 def test_tpdo_remap_event_driven(start, name):
     dev = start(name)
     setup = TPDO_SETUPS[name]
@@ -741,8 +744,8 @@ def test_tpdo_remap_event_driven(start, name):
     assert dev.read_int(0x6200, 1) == 0xA5
 
 
-@pytest.mark.parametrize("trans_type", [0, 1, 2])
-@pytest.mark.parametrize("name", ["co401gw1", "canopenia"])
+# Type 0 sends after an event: CANopenIA only (see above); the cyclic types on both.
+@pytest.mark.parametrize("name,trans_type", [("co401gw1", 1), ("co401gw1", 2), ("canopenia", 0), ("canopenia", 1), ("canopenia", 2)])
 def test_tpdo_synchronous(start, name, trans_type):
     dev = start(name)
     setup = TPDO_SETUPS[name]
@@ -811,17 +814,21 @@ def test_tpdo_event_timer_and_inhibit_time(start):
     mark = dev.rec.mark()
     assert dev.rec.wait(pdo.cob_id, mark, 0.25) is None, "TPDO sent in pre-operational"
 
+
+def test_tpdo_inhibit_time(start):
+    # SDO writes of a mapped object are events on CANopenIA (not on CO401GW1, erratum GW1-61).
+    dev = start("canopenia")
+    entries = TPDO_SETUPS["canopenia"]["map"]
     # Inhibit time 50 ms (500 x 100 us), event timer off: a burst of events is spaced out and
     # the last value still goes out.
-    dev.nmt(PRE_OP)
     pdo = remap_tpdo(dev, 1, entries, 255, event_timer=0, inhibit_time=500)
     assert dev.read_int(0x1800, 3) == 500
     dev.nmt(START)
     mark = dev.rec.mark()
     for v in range(1, 21):
-        dev.write_int(0x6411, 1, v, 2)
+        dev.write_int(0x6200, 2, v, 1)
         time.sleep(0.005)
-    last = dev.rec.wait(pdo.cob_id, mark, 1.0, lambda f: f.data[1:3] == (20).to_bytes(2, "little"))
+    last = dev.rec.wait(pdo.cob_id, mark, 1.0, lambda f: f.data[1] == 20)
     assert last is not None, "the last value must be sent once the inhibit time has passed"
     frames = dev.rec.since(mark, pdo.cob_id)
     gaps = [b.t - a.t for a, b in zip(frames, frames[1:])]
@@ -1105,6 +1112,11 @@ def test_rpdo_too_short_emcy(start, name):
     mark = dev.rec.mark()
     dev.net.send_message(cob, bytes([0x5A] * 3))
     emcy = dev.wait_emcy(mark, 0x8210, 1.0)
+    if name == "co401gw1":
+        # Only the datasheet's emergencies go out (erratum GW1-59); the RPDO is still refused.
+        assert emcy is None, f"CO401GW1 sent the CiA 301 emergency 8210h: {emcy}"
+        assert dev.read(*first) == before
+        return
     assert emcy is not None, "no EMCY 8210h for an RPDO shorter than its mapping"
     assert emcy.data[2] == 0x11, f"error register {emcy}"
     assert any(e.code == 0x8210 and e.register == 0x11 for e in dev.node.emcy.log)
@@ -1162,24 +1174,28 @@ def test_heartbeat_consumer_timeout_emcy(start, behaviour, state_after):
 
 
 def test_emcy_inhibit_time_and_cob_id(start):
+    # CO401GW1 (the device with 1015h) sends only its datasheet's emergencies (GW1-59): the
+    # life guarding error 8130h, raised 100 ms after the last guarding RTR, reset by the next.
     dev = start("co401gw1")
     dev.write_int(0x1015, 0, 1000, 2)  # 100 ms between EMCYs
-    dev.nmt(START)
-    cob = 0x200 + dev.node_id
+    dev.write_int(0x100C, 0, 50, 2)  # guard time 50 ms
+    dev.write_int(0x100D, 0, 2, 1)  # life time 100 ms
+    rtr = lambda: dev.net.send_message(dev.nmt_err_cob, b"", remote=True)  # noqa: E731
     mark = dev.rec.mark()
-    dev.net.send_message(cob, b"\x01")  # too short: 8210h
-    dev.net.send_message(cob, bytes(8))  # correct: error reset
-    raised = dev.wait_emcy(mark, 0x8210, 1.0)
+    rtr()  # guarding starts
+    raised = dev.wait_emcy(mark, 0x8130, 1.0)
+    assert raised is not None and raised.data[7] == 0x30, f"life guarding error: {raised}"
+    rtr()  # the error ends at once; its reset waits for the inhibit time
     reset = dev.wait_emcy(mark, 0x0000, 1.0)
-    assert raised is not None and reset is not None
+    assert reset is not None
     assert reset.t - raised.t >= 0.08, f"EMCYs {reset.t - raised.t:.3f} s apart, inhibit time 100 ms"
     # A new EMCY COB-ID: invalidate, then set the new identifier.
     dev.write_int(0x1014, 0, 0x80000000 | 0x85, 4)
     dev.write_int(0x1014, 0, 0x0FE, 4)
     mark = dev.rec.mark()
-    dev.net.send_message(cob, b"\x01")
-    f = dev.rec.wait(0x0FE, mark, 1.0)
-    assert f is not None and f.data[:3] == bytes([0x10, 0x82, 0x11]), f"EMCY on the new COB-ID: {f}"
+    rtr()
+    f = dev.rec.wait(0x0FE, mark, 1.0, lambda f: f.data[:2] == bytes([0x30, 0x81]))
+    assert f is not None and f.data[:3] == bytes([0x30, 0x81, 0x01]), f"EMCY on the new COB-ID: {f}"
     assert dev.rec.since(mark, dev.emcy_cob) == []
 
 
