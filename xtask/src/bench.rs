@@ -1,8 +1,9 @@
-//! `cargo xtask bench`: instruction counts of CO401Memory1's code on a Cortex-M3 under QEMU,
-//! its stack peak, the criterion benchmarks and the size report, into `target/bench/report.md`.
+//! `cargo xtask bench`: instruction counts of the devices' code on a Cortex-M3 under QEMU,
+//! their stack peaks, the criterion benchmarks and the size report, into
+//! `target/bench/report.md`.
 //!
-//! The image `bench-memory1` of `firmware/boards/qemu` runs each scenario between the marker
-//! functions `bench_begin` and `bench_end` and checks every answer; the TCG plugin
+//! Each bench image of `firmware/boards/qemu` ([`BENCHES`]) runs its scenarios between the
+//! marker functions `bench_begin` and `bench_end` and checks every answer; the TCG plugin
 //! `bench/insn-count` counts the instructions executed from the first instruction of
 //! `bench_begin` up to the first one of `bench_end`. Scenario 0 is empty, so its count is the
 //! markers' own cost (the rest of `bench_begin` and the call of `bench_end`): the net figures
@@ -17,7 +18,16 @@ use std::time::{Duration, Instant, SystemTime};
 
 const BOARD_DIR: &str = "firmware/boards/qemu";
 const TARGET: &str = "thumbv7m-none-eabi";
-const IMAGE: &str = "bench-memory1";
+/// A bench image and the device it measures.
+pub struct Bench {
+    pub image: &'static str,
+    /// The device (and the prefix of its image names in `dist`).
+    pub device: &'static str,
+    title: &'static str,
+}
+
+pub const BENCHES: &[Bench] =
+    &[Bench { image: "bench-memory1", device: "co401memory1", title: "CO401Memory1" }, Bench { image: "bench-gw1", device: "co401gw1", title: "CO401GW1" }];
 /// A run takes well under a second; this only stops a hung image.
 const QEMU_TIMEOUT: Duration = Duration::from_secs(120);
 /// The aims: instructions per expedited SDO request and per RPDO.
@@ -30,11 +40,16 @@ fn out_dir() -> PathBuf {
     root().join("target/bench")
 }
 
-/// Builds the bench image and returns its ELF.
-fn build_image() -> Result<PathBuf> {
+/// Builds the bench images and returns their ELFs, in [`BENCHES`] order.
+fn build_images() -> Result<Vec<PathBuf>> {
     let dir = root().join(BOARD_DIR);
-    run(cargo().args(["build", "--quiet", "--release", "--target", TARGET, "--bin", IMAGE]).current_dir(&dir))?;
-    Ok(dir.join("target").join(TARGET).join("release").join(IMAGE))
+    let mut cmd = cargo();
+    cmd.args(["build", "--quiet", "--release", "--target", TARGET]);
+    for b in BENCHES {
+        cmd.args(["--bin", b.image]);
+    }
+    run(cmd.current_dir(&dir))?;
+    Ok(BENCHES.iter().map(|b| dir.join("target").join(TARGET).join("release").join(b.image)).collect())
 }
 
 /// Builds the plugin into `target/bench/libinsn_count.so`.
@@ -101,22 +116,25 @@ fn check_exit(r: &QemuRun) -> Result {
     Err(format!("the bench image failed (exit code {:?}):\n{}{}", r.code, r.stdout, r.stderr))
 }
 
-/// `cargo xtask test`'s self-test: the bench image, without the plugin, must check every
-/// answer and exit with code 0. Returns the deepest stack use it measured (bytes).
-pub fn selftest() -> Result<u64> {
-    let elf = build_image()?;
-    let r = qemu(&elf, &[])?;
-    check_exit(&r)?;
-    let scenarios = r.stdout.lines().filter(|l| l.starts_with("bench ")).count();
-    let peak = r
-        .stdout
-        .lines()
-        .filter_map(|l| l.strip_prefix("stack-peak-bytes: ").or_else(|| l.strip_prefix("stack-peak-setup-bytes: ")))
-        .filter_map(|n| n.trim().parse::<u64>().ok())
-        .max()
-        .ok_or("the bench image reported no stack peak")?;
-    println!("xtask: bench image self-test passed: {scenarios} scenarios, every answer as expected; stack peak {peak} bytes");
-    Ok(peak)
+/// `cargo xtask test`'s self-test: each bench image, without the plugin, must check every
+/// answer and exit with code 0. Returns the deepest stack use each measured (device, bytes).
+pub fn selftest() -> Result<Vec<(&'static str, u64)>> {
+    let mut peaks = Vec::new();
+    for (bench, elf) in BENCHES.iter().zip(build_images()?) {
+        let r = qemu(&elf, &[])?;
+        check_exit(&r)?;
+        let scenarios = r.stdout.lines().filter(|l| l.starts_with("bench ")).count();
+        let peak = r
+            .stdout
+            .lines()
+            .filter_map(|l| l.strip_prefix("stack-peak-bytes: ").or_else(|| l.strip_prefix("stack-peak-setup-bytes: ")))
+            .filter_map(|n| n.trim().parse::<u64>().ok())
+            .max()
+            .ok_or_else(|| format!("{} reported no stack peak", bench.image))?;
+        println!("xtask: {} self-test passed: {scenarios} scenarios, every answer as expected; stack peak {peak} bytes", bench.image);
+        peaks.push((bench.device, peak));
+    }
+    Ok(peaks)
 }
 
 /// One measured scenario.
@@ -297,19 +315,29 @@ pub fn main(args: &[String]) -> Result {
     }
 }
 
-/// The instruction counts per scenario, as a Markdown table.
+/// The instruction counts per scenario of every bench image, as Markdown: a heading and a
+/// table per device.
 fn instructions() -> Result<String> {
     setup::rust_targets()?;
     let plugin = build_plugin()?;
-    let elf = build_image()?;
-    let bytes = std::fs::read(&elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
-    let marker = |name: &str| crate::elf::symbol(&bytes, name).map_err(|e| format!("{}: {e}", elf.display()));
-    let (begin, end) = (marker("bench_begin")?, marker("bench_end")?);
-    let plugin_arg = format!("{},begin={begin:#x},end={end:#x}", plugin.display());
-    let r = qemu(&elf, &["-d".into(), "plugin".into(), "-plugin".into(), plugin_arg])?;
-    check_exit(&r)?;
-    let counts = parse(&r.stdout, &r.stderr)?;
-    Ok(instruction_table(&counts))
+    let mut md = String::new();
+    for (bench, elf) in BENCHES.iter().zip(build_images()?) {
+        let bytes = std::fs::read(&elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
+        let marker = |name: &str| crate::elf::symbol(&bytes, name).map_err(|e| format!("{}: {e}", elf.display()));
+        let (begin, end) = (marker("bench_begin")?, marker("bench_end")?);
+        let plugin_arg = format!("{},begin={begin:#x},end={end:#x}", plugin.display());
+        let r = qemu(&elf, &["-d".into(), "plugin".into(), "-plugin".into(), plugin_arg])?;
+        check_exit(&r)?;
+        let counts = parse(&r.stdout, &r.stderr).map_err(|e| format!("{}: {e}", bench.image))?;
+        md.push_str(&format!(
+            "## {} on a Cortex-M3 (QEMU lm3s6965evb, instructions executed)\n\nImage `{}` ({TARGET}, release profile of `{BOARD_DIR}`), counted by the TCG plugin `bench/insn-count`: \
+             one input handed to the device and `poll` until it is quiet, every answer checked.\n\n",
+            bench.title, bench.image
+        ));
+        md.push_str(&instruction_table(&counts));
+        md.push('\n');
+    }
+    Ok(md)
 }
 
 /// Instruction counts, criterion figures and the size report into `target/bench/report.md`.
@@ -321,11 +349,7 @@ pub fn report() -> Result {
     println!("xtask: size report");
     let size = crate::size::table()?;
 
-    let mut md = String::from("# coforge benchmarks\n\n## CO401Memory1 on a Cortex-M3 (QEMU lm3s6965evb, instructions executed)\n\n");
-    md.push_str(&format!(
-        "Image `{IMAGE}` ({TARGET}, release profile of `{BOARD_DIR}`), counted by the TCG plugin `bench/insn-count`: \
-         one input handed to the module and `poll` until it is quiet, every answer checked.\n\n"
-    ));
+    let mut md = String::from("# coforge benchmarks\n\n");
     md.push_str(&table);
     md.push_str(&format!("\n## Criterion (host, mean per iteration, `{}`)\n\n| Benchmark | Mean |\n|---|---:|\n", CRITERION_ARGS.join(" ")));
     for (id, ns) in &estimates {

@@ -43,6 +43,7 @@ pub(crate) fn built_elf(board: &Board, device: &str) -> PathBuf {
 
 /// One row of the size table.
 struct Row {
+    device: &'static str,
     image: String,
     flash: u64,
     flash_budget: u32,
@@ -72,25 +73,37 @@ pub fn build() -> Result<Vec<PathBuf>> {
             std::fs::write(stem.with_extension("bin"), &bin).map_err(|e| format!("cannot write image: {e}"))?;
             println!("xtask: image {device} for {} ({}): {} bytes to flash", board.name, board.target, bin.len());
             let s = crate::size::sections(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
-            rows.push(Row { image: format!("{device}-{}", board.name), flash: s.flash(), flash_budget: board.flash.1, ram: s.ram(), ram_budget: board.ram.1 });
+            rows.push(Row {
+                device,
+                image: format!("{device}-{}", board.name),
+                flash: s.flash(),
+                flash_budget: board.flash.1,
+                ram: s.ram(),
+                ram_budget: board.ram.1,
+            });
             images.push(stem.with_extension("elf"));
         }
     }
-    // The stack is not static: the bench image runs the same module through every kind of
-    // input in QEMU and measures its deepest use (painted stack).
-    let stack = crate::bench::selftest()?;
-    size_table(&rows, stack)?;
+    // The stack is not static: each device's bench image runs it through every kind of input
+    // in QEMU and measures its deepest use (painted stack).
+    let stacks = crate::bench::selftest()?;
+    size_table(&rows, &stacks)?;
     pending_boards();
     Ok(images)
 }
 
-fn size_table(rows: &[Row], stack: u64) -> Result {
+/// Prints the size table; fails if an image is over its chip's flash or RAM. `stacks` holds
+/// each measured device's stack peak; an image of a device without one fails.
+fn size_table(rows: &[Row], stacks: &[(&str, u64)]) -> Result {
     println!(
-        "xtask: image sizes (flash = .text + .rodata + .data, static RAM = .data + .bss; stack peak measured in QEMU, Cortex-M3 build of the same module):"
+        "xtask: image sizes (flash = .text + .rodata + .data, static RAM = .data + .bss; stack peak measured in QEMU, Cortex-M3 build of the same device):"
     );
     println!("xtask: {:<22} {:>20} {:>11} {:>11} {:>22}", "image", "flash / budget", "static RAM", "stack peak", "RAM total / budget");
     let mut over = Vec::new();
     for r in rows {
+        let Some(&(_, stack)) = stacks.iter().find(|(device, _)| r.device.starts_with(device)) else {
+            return Err(format!("{}: no bench image measures the stack of {}", r.image, r.device));
+        };
         let ram = r.ram + stack;
         println!("xtask: {:<22} {:>9} / {:>8} {:>11} {:>11} {:>10} / {:>9}", r.image, r.flash, r.flash_budget, r.ram, stack, ram, r.ram_budget);
         if r.flash > u64::from(r.flash_budget) {

@@ -218,6 +218,39 @@ fn stored_parameters_survive_reset_and_restore_brings_defaults_back() {
     assert_eq!(upload(&mut bus, 0x100C, 0).unwrap(), vec![0, 0], "spec default");
 }
 
+#[test]
+fn a_save_after_a_restore_keeps_the_store_erased_until_the_next_reset() {
+    // CO401GW1 1010h: "If the save command is done after a restore procedure, a previously
+    // saved dictionary is deleted, so the chip will start with default data."
+    let mut bus = bus("co401gw1");
+    download(&mut bus, 0x100C, 0, &500_u16.to_le_bytes()).unwrap();
+    download(&mut bus, 0x1010, 1, b"save").unwrap();
+    download(&mut bus, 0x1011, 1, b"load").unwrap();
+    download(&mut bus, 0x100C, 0, &600_u16.to_le_bytes()).unwrap();
+    download(&mut bus, 0x1010, 1, b"save").unwrap();
+    nmt(&mut bus, 0x81);
+    bus.drain();
+    assert_eq!(upload(&mut bus, 0x100C, 0).unwrap(), vec![0, 0], "neither 500 nor 600 was kept: defaults");
+    // After that reset the dictionary shows the defaults again, and saving works as before.
+    download(&mut bus, 0x100C, 0, &700_u16.to_le_bytes()).unwrap();
+    download(&mut bus, 0x1010, 1, b"save").unwrap();
+    nmt(&mut bus, 0x81);
+    bus.drain();
+    assert_eq!(upload(&mut bus, 0x100C, 0).unwrap(), 700_u16.to_le_bytes().to_vec(), "saved after the reset");
+    // A reset of communication does not end a pending restore: the application entries
+    // (2180h) still show the values the restore discarded.
+    download(&mut bus, 0x2180, 0, &1234_u16.to_le_bytes()).unwrap();
+    download(&mut bus, 0x1010, 1, b"save").unwrap();
+    download(&mut bus, 0x1011, 1, b"load").unwrap();
+    nmt(&mut bus, 0x82);
+    bus.drain();
+    assert_eq!(upload(&mut bus, 0x2180, 0).unwrap(), 1234_u16.to_le_bytes().to_vec(), "not reloaded by reset communication");
+    download(&mut bus, 0x1010, 1, b"save").unwrap();
+    nmt(&mut bus, 0x81);
+    bus.drain();
+    assert_eq!(upload(&mut bus, 0x2180, 0).unwrap(), 1000_u16.to_le_bytes().to_vec(), "2180h default, not the discarded 1234");
+}
+
 fn emcy_frames(bus: &mut VirtualBus) -> Vec<[u8; 8]> {
     bus.drain().into_iter().filter(|f| f.id == 0x80 + u16::from(ID)).map(|f| f.data).collect()
 }

@@ -1,9 +1,11 @@
 //! The lm3s6965evb board as QEMU emulates it: a millisecond clock from SysTick, the two UARTs
 //! the images use, banks kept in host files through semihosting, and the main loop every
-//! image runs its device in (`serve`, generic over the device contract). The devices are the
+//! image runs its device in (`serve`, generic over the device contract), and what the bench
+//! images share (`bench`). The devices are the
 //! device crates'; each image builds its own.
 #![no_std]
 
+pub mod bench;
 pub mod clock;
 pub mod host_file;
 pub mod serve;

@@ -310,6 +310,13 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
     fn input_events(&mut self) {
         let running = self.node.can_enabled();
         let od = self.node.od();
+        // Unchanged data is never an event (`ds401`): most inputs change no input at all.
+        let bytes = usize::from(od.app.bytes());
+        let digital_same = self.inputs_seen.get(..bytes) == od.app.inputs.get(..bytes);
+        let analog_same = od.mode() != Mode::Mixed || od.read_analog_input.items.get(..CHANNELS) == Some(&self.analog_seen[..]);
+        if digital_same && analog_same {
+            return;
+        }
         let masks = |i: usize| DigitalMasks {
             any_change: od.interrupt_mask_any_change.items.get(i).copied().unwrap_or(0),
             low_to_high: od.interrupt_mask_low_to_high.items.get(i).copied().unwrap_or(0),
@@ -346,10 +353,18 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         if !running {
             return;
         }
+        // Each changed byte triggers its 8-bit entry and the 16- and 32-bit views that hold
+        // it, each view entry once however many of its bytes changed.
+        let (mut words, mut longs) = (0_u8, 0_u8);
         for i in (0..IMAGE as u8).filter(|i| digital & 1 << i != 0) {
             self.node.trigger_mapped(index::DIGITAL_INPUT_8_BIT, i + 1);
-            self.node.trigger_mapped(index::READ_DIGITAL_INPUT_16_BIT, i / 2 + 1);
-            self.node.trigger_mapped(index::READ_DIGITAL_INPUT_32_BIT, i / 4 + 1);
+            (words, longs) = (words | 1 << (i / 2), longs | 1 << (i / 4));
+        }
+        for w in (0..8_u8).filter(|w| words & 1 << w != 0) {
+            self.node.trigger_mapped(index::READ_DIGITAL_INPUT_16_BIT, w + 1);
+        }
+        for l in (0..4_u8).filter(|l| longs & 1 << l != 0) {
+            self.node.trigger_mapped(index::READ_DIGITAL_INPUT_32_BIT, l + 1);
         }
         for ch in (0..CHANNELS as u8).filter(|ch| analog & 1 << ch != 0) {
             self.node.trigger_mapped(index::READ_ANALOG_INPUT, ch + 1);
@@ -361,7 +376,10 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
     /// command's report must see 2E01h as the host set it), then the rest become unsolicited
     /// telegrams as 2E01h enables them; all go on to the runtime.
     fn take_node_events(&mut self) {
+        // Most inputs raise no event: nothing to gather, nothing to update again.
+        let Some(first) = self.node.take_event() else { return };
         let mut events: heapless::Vec<NodeEvent, EVENTS> = heapless::Vec::new();
+        let _ = events.push(first);
         while let Some(event) = self.node.take_event() {
             if events.is_full() {
                 events.remove(0);
@@ -371,7 +389,8 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         if events.contains(&NodeEvent::ResetApplication) {
             self.node.od_mut().app.outputs = [0; IMAGE];
         }
-        if events.iter().any(|e| matches!(e, NodeEvent::ResetApplication | NodeEvent::ResetCommunication)) {
+        let reset = events.iter().any(|e| matches!(e, NodeEvent::ResetApplication | NodeEvent::ResetCommunication));
+        if reset {
             self.after_reset();
         }
         let control = self.node.od().gateway_transfer_control.clone();
@@ -400,8 +419,10 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
             let state = self.nmt_state_code();
             self.send_host(&DeviceToHost::NmtStateAnswer { state });
         }
-        // An NMT reset may have changed what the outputs and events show.
-        self.update();
+        if reset {
+            // The reset reloaded what the outputs and the event rules read.
+            self.update();
+        }
     }
 
     /// The state byte of `50`: 00 (boot-up) until CAN is enabled.
@@ -558,7 +579,9 @@ impl<B: Board, S: ParamStore> Device for Gw1<B, S> {
         // The frame's EMCY, if it is one, is reported with the events below.
         let frame = self.node.poll(now_us);
         self.after_input(now_us);
-        frame
+        // The pins read just now may have queued a TPDO or an EMCY: out in this pass, not
+        // the next (its events are reported by the next input).
+        frame.or_else(|| self.node.poll(now_us))
     }
 
     fn on_bus_state(&mut self, bus: BusState, now_us: u64) {

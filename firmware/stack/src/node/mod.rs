@@ -99,6 +99,9 @@ pub struct Core<D, S, const P: usize> {
     powered: bool,
     /// The CAN side runs: frames are received and sent (CO401GW1's host enables it).
     can_enabled: bool,
+    /// 1011h erased the store and the dictionary has not been reloaded since: a 1010h save
+    /// keeps the store erased (see `store_command`).
+    restore_pending: bool,
     now_us: u64,
     tx: Ring<CanFrame, TX_QUEUE>,
     events: Ring<NodeEvent, EVENTS>,
@@ -156,6 +159,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
             state: NmtState::PreOperational,
             powered: false,
             can_enabled: false,
+            restore_pending: false,
             now_us: 0,
             tx: Self::NO_FRAMES,
             events: Self::NO_EVENTS,
@@ -448,6 +452,10 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         self.od.reset_area(area, self.node_id);
         // A store that cannot be read leaves the defaults: the node must still boot.
         let _ = self.store.load(&mut self.od, area);
+        if area == Area::ALL {
+            // Every entry holds its default now: a save stores what it shows again.
+            self.restore_pending = false;
+        }
     }
 
     /// The communication side starts afresh: services from the dictionary, boot-up message,

@@ -34,11 +34,18 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
         }
         // Manufacturer-specific sub-indices beyond 4 act on everything.
         let area = crate::od::Area::of_store_sub(sub).unwrap_or(crate::od::Area::ALL);
-        let result = if index == 0x1010 {
+        let result = if index == 0x1010 && self.restore_pending {
+            // The dictionary still shows the values the restore discarded (the defaults take
+            // effect at the next reset): saving them would undo the restore, so the store
+            // stays erased and the node starts with defaults (CO401GW1 1010h).
+            self.store.erase(&self.od)
+        } else if index == 0x1010 {
             self.store.save(&self.od, area)
         } else if area == crate::od::Area::ALL {
             // Restored defaults take effect at the next reset (CiA 301).
-            self.store.erase(&self.od)
+            let erased = self.store.erase(&self.od);
+            self.restore_pending = erased.is_ok();
+            erased
         } else {
             // One area of a single stored block: store that area's defaults.
             self.od.reset_area(area, self.node_id);
