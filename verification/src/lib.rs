@@ -13,6 +13,7 @@
 
 pub mod banks;
 pub mod framing;
+pub mod gw1;
 pub mod integrity;
 pub mod node;
 pub mod stack;
