@@ -20,7 +20,8 @@ use coforge_stack::frame::CanFrame;
 use coforge_stack::leds::{LedState, Leds};
 use coforge_stack::nmt::{NmtState, state_code};
 use coforge_stack::node::{BusState, NodeEvent};
-use coforge_stack::od::{NodeDictionary, Side};
+use coforge_stack::od::{EntryAccess, NodeDictionary, Side};
+use coforge_stack::pdo::Dir;
 use coforge_stack::store::{BlockStore, ParamStore};
 use heapless::Deque;
 
@@ -437,7 +438,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
     /// `4P` with RPDO P+1's data; unless `always`, only if it differs from what the host was
     /// last given.
     fn send_rpdo(&mut self, pdo: u8, always: bool) -> bool {
-        let Some(data) = self.pdo_data(index::RPDO1_MAPPING + u16::from(pdo)) else { return false };
+        let Some(data) = self.rpdo_data(pdo) else { return false };
         let Some(given) = self.given.get_mut(usize::from(pdo)) else { return false };
         if !always && given.as_ref() == Some(&data) {
             return true;
@@ -457,44 +458,26 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         }
     }
 
-    /// The mapped entries of PDO mapping object `mapping`: `(index, sub, bytes)` each.
-    fn mapped(&mut self, mapping: u16) -> heapless::Vec<(u16, u8, usize), 8> {
-        let mut count = [0];
-        let _ = self.node.read(mapping, 0, 0, &mut count, Side::Device);
-        let mut entries = heapless::Vec::new();
-        for sub in 1..=count[0].min(8) {
-            let mut word = [0; 4];
-            if self.node.read(mapping, sub, 0, &mut word, Side::Device).is_ok() {
-                let m = u32::from_le_bytes(word);
-                let _ = entries.push(((m >> 16) as u16, (m >> 8) as u8, (m & 0xFF) as usize / 8));
-            }
-        }
-        entries
-    }
-
-    /// The data of a PDO as its mapping lays it out, from the dictionary.
-    fn pdo_data(&mut self, mapping: u16) -> Option<Bytes> {
-        let mut data = [0_u8; 8];
-        let mut at = 0;
-        for (index, sub, len) in self.mapped(mapping) {
-            let dst = data.get_mut(at..at + len)?;
-            // Dummy entries (0005h..0007h) read as zero.
-            let _ = self.node.read(index, sub, 0, dst, Side::Device);
-            at += len;
-        }
-        Bytes::from_slice(data.get(..at)?).ok()
+    /// The data of RPDO P+1 as its mapping lays it out, from the dictionary (dummy entries
+    /// read as zero).
+    fn rpdo_data(&mut self, pdo: u8) -> Option<Bytes> {
+        let (data, len) = self.node.pdo_data(Dir::Rx, u16::from(pdo) + 1)?;
+        Bytes::from_slice(data.get(..usize::from(len))?).ok()
     }
 
     /// `3P`: the host's bytes into the entries TPDO P+1 maps, as the PDO lays them out.
     /// Entries the host may not write (below 3000h, a dummy) keep their values; bytes past the
     /// mapping are ignored, a mapped entry the data does not cover is left as it is.
     fn write_tpdo(&mut self, pdo: u8, data: &[u8]) {
+        let Some(mapping) = self.node.pdo_mapping(Dir::Tx, u16::from(pdo) + 1).copied() else { return };
+        let entries = self.node.od().entries();
         let mut at = 0;
-        for (index, sub, len) in self.mapped(index::TPDO1_MAPPING + u16::from(pdo)) {
-            if let Some(bytes) = data.get(at..at + len) {
-                let _ = self.node.write(index, sub, bytes, Side::Host);
+        for e in mapping.entries() {
+            let end = at + usize::from(e.bytes());
+            if let (Some(bytes), Some(info)) = (data.get(at..end), e.info(entries)) {
+                let _ = self.node.write(e.index(info), e.sub, bytes, Side::Host);
             }
-            at += len;
+            at = end;
         }
     }
 

@@ -380,6 +380,37 @@ fn remapping_follows_2102() {
 }
 
 #[test]
+fn remapped_pdos_carry_the_host_data_as_mapped() {
+    // 2102h = 1 (default): RPDO1 remapped to a dummy byte, 6200h.2 and 6200h.1; TPDO1 to
+    // 6000h.3 and 6000h.2.
+    let mut rig = Rig::enabled(true);
+    assert_eq!(rig.sdo_write(0x1400, 1, &(0x8000_0205_u32).to_le_bytes())[0], 0x60);
+    assert_eq!(rig.sdo_write(0x1600, 0, &[0])[0], 0x60);
+    for (sub, word) in [(1, 0x0005_0008_u32), (2, 0x6200_0208), (3, 0x6200_0108)] {
+        assert_eq!(rig.sdo_write(0x1600, sub, &word.to_le_bytes())[0], 0x60, "1600h.{sub}");
+    }
+    assert_eq!(rig.sdo_write(0x1600, 0, &[3])[0], 0x60);
+    assert_eq!(rig.sdo_write(0x1400, 1, &(0x205_u32).to_le_bytes())[0], 0x60);
+    assert_eq!(rig.sdo_write(0x1800, 1, &(0x8000_0185_u32).to_le_bytes())[0], 0x60);
+    assert_eq!(rig.sdo_write(0x1A00, 0, &[0])[0], 0x60);
+    for (sub, word) in [(1, 0x6000_0308_u32), (2, 0x6000_0208)] {
+        assert_eq!(rig.sdo_write(0x1A00, sub, &word.to_le_bytes())[0], 0x60, "1A00h.{sub}");
+    }
+    assert_eq!(rig.sdo_write(0x1A00, 0, &[2])[0], 0x60);
+    assert_eq!(rig.sdo_write(0x1800, 1, &(0x185_u32).to_le_bytes())[0], 0x60);
+    rig.start_node();
+    // The dummy byte is dropped, the others land in 6200h.2 and 6200h.1; `40` reads them
+    // back in the mapping's order, the dummy as zero.
+    rig.frame(0x200 + NODE, &[0xEE, 0x22, 0x11]);
+    assert_eq!(rig.command(&[0x40, 0x00]), [0x40, 0x03, 0x00, 0x22, 0x11]);
+    // `30` fills 6000h.3 and 6000h.2 in the mapping's order; TPDO1 carries them.
+    rig.take_sent();
+    assert_eq!(rig.command(&[0x30, 0x02, 0x33, 0x22]), [0x30, 0x00]);
+    let tpdo: Vec<_> = rig.take_sent().into_iter().filter(|f| f.id == 0x180 + NODE).map(|f| f.payload().to_vec()).collect();
+    assert_eq!(tpdo, [vec![0x33, 0x22]]);
+}
+
+#[test]
 fn leds_and_watchdog_follow_the_state() {
     let mut rig = Rig::boot(NODE as u8, true);
     assert!(!rig.chip.board().run_lit && !rig.chip.board().error_lit, "dark before enable");

@@ -30,8 +30,9 @@ use crate::heartbeat::{Consumer, ConsumerEvent, Producer};
 use crate::leds::Leds;
 use crate::nmt::{self, NmtCommand, NmtState};
 use crate::od::{AccessContext, Area, EntryAccess, NodeDictionary, SdoAbort, Side};
+use crate::pdo::mapping::Mapping;
 use crate::pdo::slot::NEVER;
-use crate::pdo::{Rpdo, Tpdo};
+use crate::pdo::{Dir, Rpdo, Tpdo};
 use crate::ring::Ring;
 use crate::sdo::SdoServer;
 use crate::store::ParamStore;
@@ -352,6 +353,23 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
     /// permitting; acyclic synchronous: at the next SYNC).
     pub fn trigger_mapped(&mut self, index: u16, sub: u8) {
         self.core.trigger_mapped(index, sub);
+    }
+
+    /// The checked mapping of PDO `number` (1-based: RPDO1 is 1400h/1600h, TPDO1
+    /// 1800h/1A00h) as the node uses it; `None` if the dictionary has no such PDO.
+    pub fn pdo_mapping(&self, dir: Dir, number: u16) -> Option<&Mapping> {
+        let offset = number.checked_sub(1)?;
+        match dir {
+            Dir::Rx => self.core.rpdos.iter().find(|r| r.offset == offset).map(|r| &r.mapping),
+            Dir::Tx => self.core.tpdos.iter().find(|t| t.offset == offset).map(|t| &t.mapping),
+        }
+    }
+
+    /// The values PDO `number`'s mapping maps, packed as its frame carries them: the data
+    /// bytes and their count. `None` if there is no such PDO or an entry cannot be read.
+    pub fn pdo_data(&mut self, dir: Dir, number: u16) -> Option<([u8; 8], u8)> {
+        let mapping = *self.pdo_mapping(dir, number)?;
+        mapping.pack(&mut self.core.od).ok()
     }
 
     /// An application event for TPDO `number` (1-based: TPDO1 is 1800h).

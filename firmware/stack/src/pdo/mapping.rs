@@ -153,6 +153,11 @@ impl Mapping {
         for e in self.entries() {
             let end = at + usize::from(e.bytes());
             let dst = out.get_mut(at..end).ok_or(SdoAbort::PdoTooLong)?;
+            if e.is_dummy() {
+                // Only RPDOs map dummies; their bytes read as zero (CO401GW1's `4P`).
+                at = end;
+                continue;
+            }
             let info = e.info(entries).ok_or(SdoAbort::NoObject)?;
             od.read_entry(info, e.index(info), e.sub, 0, dst)?;
             at = end;
