@@ -312,9 +312,11 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         let running = self.node.can_enabled();
         let od = self.node.od();
         // Unchanged data is never an event (`ds401`): most inputs change no input at all.
-        let bytes = usize::from(od.app.bytes());
-        let digital_same = self.inputs_seen.get(..bytes) == od.app.inputs.get(..bytes);
-        let analog_same = od.mode() != Mode::Mixed || od.read_analog_input.items.get(..CHANNELS) == Some(&self.analog_seen[..]);
+        // Whole-array compares (word loads), not slices (a byte-wise `memcmp`).
+        let bytes = u32::from(od.app.bytes());
+        let in_use = u128::MAX.checked_shr(128 - 8 * bytes.min(16)).unwrap_or(0);
+        let digital_same = (u128::from_le_bytes(self.inputs_seen) ^ u128::from_le_bytes(od.app.inputs)) & in_use == 0;
+        let analog_same = od.mode() != Mode::Mixed || od.read_analog_input.items == self.analog_seen;
         if digital_same && analog_same {
             return;
         }
