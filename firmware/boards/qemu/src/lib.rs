@@ -1,10 +1,11 @@
-//! The lm3s6965evb board as QEMU emulates it: a millisecond clock from SysTick, the two UARTs
-//! the images use, banks kept in host files through semihosting, and the main loop every
-//! image runs its device in (`serve`, generic over the device contract). The devices are the
-//! device crates'; each image builds its own.
+//! The lm3s6965evb board as QEMU emulates it: a millisecond clock from SysTick, the UARTs
+//! the images use, banks kept in host files through semihosting, the main loop every image
+//! runs its device in (`serve`, generic over the device contract) and a line console for a
+//! third UART. The devices are the device crates'; each image builds its own.
 #![no_std]
 
 pub mod clock;
 pub mod host_file;
+pub mod line_console;
 pub mod serve;
 pub mod uart;

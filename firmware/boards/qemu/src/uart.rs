@@ -5,6 +5,8 @@
 pub const UART0: usize = 0x4000_C000;
 /// UART1 (the second `-serial`).
 pub const UART1: usize = 0x4000_D000;
+/// UART2 (the third `-serial`).
+pub const UART2: usize = 0x4000_E000;
 
 const DR: usize = 0x000;
 const FR: usize = 0x018;
@@ -29,7 +31,7 @@ impl Uart {
     }
 
     fn read_reg(&self, offset: usize) -> u32 {
-        // SAFETY: `base` is one of the two UART blocks above and `offset` one of the register
+        // SAFETY: `base` is one of the three UART blocks above and `offset` one of the register
         // offsets of its data sheet: an aligned, always-mapped device register.
         unsafe { core::ptr::read_volatile((self.base + offset) as *const u32) }
     }
