@@ -182,8 +182,10 @@ def test_boot_phase_enable_and_identity(gw1):
     assert host.silent(0.9) is True, "nothing but 01 00 before enable"
     times = host.bootups
     assert len(times) >= 3, f"boot-up telegrams in 0.9 s: {len(times)}"
+    # Each is due 250 ms after the last was sent: on a busy machine a late pass of the
+    # image's loop delays the rest too, hence the upper bound's margin.
     mean = (times[-1] - times[0]) / (len(times) - 1)
-    assert 0.2 < mean < 0.3, f"boot-up telegram period {mean:.3f} s"
+    assert 0.2 < mean < 0.35, f"boot-up telegram period {mean:.3f} s"
     # CAN is off: no SDO answer, no frame (7FFh is Sim._bus_ready's probe).
     mark = gw1.rec.mark()
     gw1.node.sdo.RESPONSE_TIMEOUT = 0.3
@@ -268,6 +270,9 @@ def test_console_answers_alike(gw1):
     mark = gw1.rec.mark()
     assert gw1.console("enable") == "CAN enabled in mode mixed"
     assert gw1.rec.wait(gw1.cob(0x700), mark, WAIT, lambda f: f.data == BOOTUP_FRAME) is not None, "no CAN boot-up after the console's enable"
+    # A boot-up telegram sent just before the enable may still be on its way on the host's
+    # line (the console's UART is another): taken as one for 0.1 s, then none may come.
+    assert gw1.host.silent(0.1) is True
     gw1.host.enabled = True
     assert gw1.host.silent(0.6) is True, "telegrams after the console's enable"
     assert gw1.host.xfer(h("50 00")) == X("50 01 7F")

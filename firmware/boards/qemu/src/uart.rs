@@ -14,6 +14,8 @@ const LCRH: usize = 0x02C;
 const CTL: usize = 0x030;
 const FR_RXFE: u32 = 1 << 4;
 const FR_TXFF: u32 = 1 << 5;
+const LCRH_FEN: u32 = 1 << 4;
+const LCRH_WLEN_8: u32 = 0b11 << 5;
 
 /// One UART by its base address.
 #[derive(Debug)]
@@ -22,10 +24,14 @@ pub struct Uart {
 }
 
 impl Uart {
-    /// Enables `base` for 8N1, transmit and receive.
+    /// Enables `base` for 8N1 with its FIFOs, transmit and receive. With the receive FIFO
+    /// QEMU queues up to 16 received bytes without waiting for the program to read each one;
+    /// without it QEMU hands over the next byte only after the data register was read, and a
+    /// busy host can stretch the gap between two bytes of a telegram past a protocol's
+    /// inter-byte timeout (CO401GW1's 10 ms).
     pub fn new(base: usize) -> Uart {
         let uart = Uart { base };
-        uart.write_reg(LCRH, 0x60);
+        uart.write_reg(LCRH, LCRH_WLEN_8 | LCRH_FEN);
         uart.write_reg(CTL, 0x301);
         uart
     }
