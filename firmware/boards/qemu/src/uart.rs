@@ -5,6 +5,8 @@
 pub const UART0: usize = 0x4000_C000;
 /// UART1 (the second `-serial`).
 pub const UART1: usize = 0x4000_D000;
+/// UART2 (the third `-serial`).
+pub const UART2: usize = 0x4000_E000;
 
 const DR: usize = 0x000;
 const FR: usize = 0x018;
@@ -12,6 +14,8 @@ const LCRH: usize = 0x02C;
 const CTL: usize = 0x030;
 const FR_RXFE: u32 = 1 << 4;
 const FR_TXFF: u32 = 1 << 5;
+const LCRH_FEN: u32 = 1 << 4;
+const LCRH_WLEN_8: u32 = 0b11 << 5;
 
 /// One UART by its base address.
 #[derive(Debug)]
@@ -20,16 +24,20 @@ pub struct Uart {
 }
 
 impl Uart {
-    /// Enables `base` for 8N1, transmit and receive.
+    /// Enables `base` for 8N1 with its FIFOs, transmit and receive. With the receive FIFO
+    /// QEMU queues up to 16 received bytes without waiting for the program to read each one;
+    /// without it QEMU hands over the next byte only after the data register was read, and a
+    /// busy host can stretch the gap between two bytes of a telegram past a protocol's
+    /// inter-byte timeout (CO401GW1's 10 ms).
     pub fn new(base: usize) -> Uart {
         let uart = Uart { base };
-        uart.write_reg(LCRH, 0x60);
+        uart.write_reg(LCRH, LCRH_WLEN_8 | LCRH_FEN);
         uart.write_reg(CTL, 0x301);
         uart
     }
 
     fn read_reg(&self, offset: usize) -> u32 {
-        // SAFETY: `base` is one of the two UART blocks above and `offset` one of the register
+        // SAFETY: `base` is one of the three UART blocks above and `offset` one of the register
         // offsets of its data sheet: an aligned, always-mapped device register.
         unsafe { core::ptr::read_volatile((self.base + offset) as *const u32) }
     }

@@ -7,7 +7,8 @@
 //! - [`image`]: the process image behind 6000h/6100h/6120h and 6200h/6300h/6320h;
 //! - [`ds401`]: when an input change is an event, what the outputs show on an error;
 //! - [`host`]: the host's commands as requests, and its configuration before enable;
-//! - [`device`]: the whole chip, driven by CAN frames, serial bytes and time.
+//! - [`device`]: the whole chip, driven by CAN frames, serial bytes and time;
+//! - [`console`]: the pin console of the simulator and the QEMU image.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(warnings)]
@@ -20,11 +21,13 @@ extern crate std;
 coforge_macros::device!("../../../spec/co401gw1.yaml");
 
 pub mod board;
+pub mod console;
 pub mod device;
 pub mod ds401;
 pub mod host;
 pub mod image;
 
 pub use board::{Board, FixedBoard, PinConfig};
+pub use console::{Answer, Command, ConsoleError};
 pub use device::Gw1;
 pub use image::IoImage;
