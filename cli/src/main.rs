@@ -70,6 +70,8 @@ enum Cmd {
     Sim {
         /// Device crate name: co401memory1, co401gw1, cr3101 or canopenia.
         device: String,
+        /// Node-ID 1..=127 (the ID pins); for co401gw1, 0 sets its ID pins all high, so that
+        /// the host programs the node-ID (100Bh) before it enables CAN.
         #[arg(long, default_value_t = 1)]
         node_id: u8,
         /// TCP port of the hub (0 picks a free one; the address is printed).

@@ -196,9 +196,13 @@ def dictionary(mode):
 
 
 class Sim:
-    def __init__(self, mode="mixed", extra=()):
+    """`pins`: the node-ID the ID pins select (0: all high, the host programs 100Bh);
+    `node_id`: the one python-canopen addresses (the pins' unless given)."""
+
+    def __init__(self, mode="mixed", extra=(), pins=NODE_ID, node_id=None):
         self.mode = mode
-        args = [COFORGE, "sim", "co401gw1", "--node-id", str(NODE_ID), "--port", "0", "--serial", "0"]
+        self.node_id = pins if node_id is None else node_id
+        args = [COFORGE, "sim", "co401gw1", "--node-id", str(pins), "--port", "0", "--serial", "0"]
         if mode != "mixed":
             args += ["--mode", mode]
         args += list(extra)
@@ -207,14 +211,14 @@ class Sim:
         self.net = self.host = None
         try:
             serial_url = self.sim.banner(r"serial host on (socket://\S+)")
-            can_url = self.sim.banner(rf"co401gw1 node-ID {NODE_ID} on slcan (socket://\S+)")
+            can_url = self.sim.banner(rf"co401gw1 node-ID {pins} on slcan (socket://\S+)")
             self.net = canopen.Network()
             self.net.NOTIFIER_CYCLE = 0.05
             self.rec = Recorder()
             self.net.listeners.insert(0, self.rec)  # sees each frame before python-canopen does
             self.net.connect(interface="slcan", channel=can_url, sleep_after_open=0, bitrate=500000)
             self._bus_ready(can_url)
-            self.node = canopen.RemoteNode(NODE_ID, od)
+            self.node = canopen.RemoteNode(self.node_id, od)
             self.node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
             self.net.add_node(self.node)
             self.host = Host(serial_url)
@@ -263,14 +267,14 @@ class Sim:
     # CANopen helpers -------------------------------------------------------------------------
 
     def cob(self, base):
-        return base + NODE_ID
+        return base + self.node_id
 
     def nmt(self, command):
         self.node.nmt.send_command(command)
 
     def guarded_state(self, timeout=WAIT):
         """The NMT state from a node guarding answer (also proves earlier frames were handled)."""
-        cob = 0x700 + NODE_ID
+        cob = 0x700 + self.node_id
         mark = self.rec.mark()
         self.net.send_message(cob, b"", remote=True)
         f = self.rec.wait(cob, mark, timeout, lambda f: len(f.data) == 1 and f.data != b"\x00")
@@ -388,6 +392,26 @@ def test_enable_starts_can(sim):
     assert sim.host.xfer(h("02 00")) == X("02 00")
     assert sim.guarded_state() == PRE_OPERATIONAL
     assert sim.rec.wait(sim.cob(0x700), mark, 0.2, lambda f: f.data == b"\x00") is None, "a second CAN boot-up"
+
+
+def test_programmable_node_id_set_by_the_host_before_enable():
+    """ID pins all high (`--node-id 0`): no node-ID, so enable is refused (no answer) until
+    the host writes 100Bh; then CAN starts at that node-ID, and 100Bh is refused after."""
+    s = Sim(pins=0, node_id=7)
+    try:
+        host = s.host
+        host.refused(h("02 00"))
+        assert host.xfer(h("20 04 0B 10 00 07")) == X("20 00")
+        mark = s.rec.mark()
+        host.enable()
+        assert s.rec.wait(0x707, mark, WAIT, lambda f: f.data == b"\x00") is not None, "boot-up at the programmed node-ID 7"
+        # 100Bh is not on the CAN side (access none); the host reads it.
+        assert host.xfer(h("21 03 0B 10 00")) == X("21 04 0B 10 00 07")
+        assert s.read_int(0x1018, 1) == 0x58, "SDO at 0x607/0x587"
+        host.refused(h("20 04 0B 10 00 09"))
+        assert host.xfer(h("21 03 0B 10 00")) == X("21 04 0B 10 00 07")
+    finally:
+        s.close()
 
 
 def test_enable_digital_mode_pdo5_disabled():

@@ -115,8 +115,10 @@ fn build<T: Assemble<Eeprom> + Console + Send + 'static>(
     store: &StoreAt,
 ) -> Result<Box<dyn SimDevice>, String> {
     let bad_node_id = || format!("node-ID {node_id} is outside 1..=127");
-    // Checked first, so that no file is created for a device that cannot run.
-    if !(1..=127).contains(&node_id) {
+    // Checked first, so that no file is created for a device that cannot run. 0 goes on to
+    // the device: CO401GW1 takes it as ID pins all high (the host sets 100Bh); the others
+    // refuse it before they ask for memory.
+    if node_id > 127 {
         return Err(bad_node_id());
     }
     let mut file_error = None;

@@ -395,6 +395,10 @@ fn the_registry_names_devices_modes_and_spec_emergencies() {
     assert_eq!(create("co401gw1", Some("analog"), ID).unwrap(), "co401gw1 has no mode `analog`; its modes are: mixed, digital, digital_alt");
     assert_eq!(create("co401memory1", Some("mixed"), ID).unwrap(), "co401memory1 has no mode `mixed`; its modes are: default");
     assert_eq!(create("cr3101", None, 0).unwrap(), "node-ID 0 is outside 1..=127");
+    assert_eq!(create("co401memory1", None, 0).unwrap(), "node-ID 0 is outside 1..=127");
+    assert_eq!(create("cr3101", None, 128).unwrap(), "node-ID 128 is outside 1..=127");
+    // CO401GW1's ID pins all high: the host programs the node-ID (100Bh) before enable.
+    assert_eq!(create("co401gw1", None, 0), None);
     assert_eq!(create("co401gw1", Some("digital"), ID), None);
 
     let mut bus = bus("co401gw1");
