@@ -1,6 +1,8 @@
 //! CiA 303-3 indicator states: what the run and error LEDs show, as levels the board puts on
 //! its pins.
 
+use crate::time::div_rem_u64;
+
 /// A CiA 303-3 LED pattern.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LedState {
@@ -20,20 +22,21 @@ pub enum LedState {
 
 impl LedState {
     /// Whether the LED is lit `now_ms` after an arbitrary epoch.
+    /// (The remainders are taken by [`div_rem_u64`]: no 64-bit division on a Cortex-M0.)
     pub const fn level(self, now_ms: u64) -> bool {
         let flashes = match self {
             LedState::Off => return false,
             LedState::On => return true,
-            LedState::Flickering => return now_ms % 100 < 50,
-            LedState::Blinking => return now_ms % 400 < 200,
+            LedState::Flickering => return div_rem_u64(now_ms, 100).1 < 50,
+            LedState::Blinking => return div_rem_u64(now_ms, 400).1 < 200,
             LedState::SingleFlash => 1,
             LedState::DoubleFlash => 2,
             LedState::TripleFlash => 3,
         };
         // n flashes of 200 ms on / 200 ms off, the last off phase stretched to 1000 ms.
         let period = flashes * 400 + 800;
-        let t = now_ms % period;
-        t < flashes * 400 && t % 400 < 200
+        let t = div_rem_u64(now_ms, period).1;
+        t < flashes as u32 * 400 && t % 400 < 200
     }
 }
 

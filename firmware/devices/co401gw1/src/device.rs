@@ -22,6 +22,7 @@ use coforge_stack::nmt::{NmtState, state_code};
 use coforge_stack::node::{BusState, NodeEvent};
 use coforge_stack::od::{NodeDictionary, Side};
 use coforge_stack::store::{BlockStore, ParamStore};
+use coforge_stack::time::{div_rem_u64, ms_of_us};
 use heapless::Deque;
 
 /// Bytes waiting for the host: two of the longest telegrams (an emergency report is 10 bytes,
@@ -230,7 +231,8 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
             return (false, false);
         }
         let Leds { run, error } = self.node.leds();
-        let run_lit = if run == LedState::On && self.node.state() == NmtState::Operational { now_ms % 200 >= 10 } else { run.level(now_ms) };
+        let operational = run == LedState::On && self.node.state() == NmtState::Operational;
+        let run_lit = if operational { div_rem_u64(now_ms, 200).1 >= 10 } else { run.level(now_ms) };
         (run_lit, error.level(now_ms))
     }
 
@@ -361,14 +363,15 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
     /// command's report must see 2E01h as the host set it), then the rest become unsolicited
     /// telegrams as 2E01h enables them; all go on to the runtime.
     fn take_node_events(&mut self) {
-        let mut events: heapless::Vec<NodeEvent, EVENTS> = heapless::Vec::new();
+        // The newest EVENTS: a ring, not a `Vec` whose `remove(0)` would link `memmove`.
+        let mut events: Deque<NodeEvent, EVENTS> = Deque::new();
         while let Some(event) = self.node.take_event() {
             if events.is_full() {
-                events.remove(0);
+                events.pop_front();
             }
-            let _ = events.push(event);
+            let _ = events.push_back(event);
         }
-        if events.contains(&NodeEvent::ResetApplication) {
+        if events.iter().any(|e| *e == NodeEvent::ResetApplication) {
             self.node.od_mut().app.outputs = [0; IMAGE];
         }
         if events.iter().any(|e| matches!(e, NodeEvent::ResetApplication | NodeEvent::ResetCommunication)) {
@@ -542,8 +545,8 @@ impl<B: Board, S: ParamStore> Device for Gw1<B, S> {
     fn start(&mut self, now_us: u64) {
         self.node.power_on(now_us);
         self.after_reset();
-        self.phase = Phase::Boot { next_bootup_ms: now_us / 1000 };
-        self.tick(now_us / 1000);
+        self.phase = Phase::Boot { next_bootup_ms: ms_of_us(now_us) };
+        self.tick(ms_of_us(now_us));
         self.after_input(now_us);
     }
 
@@ -554,7 +557,7 @@ impl<B: Board, S: ParamStore> Device for Gw1<B, S> {
     }
 
     fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
-        self.tick(now_us / 1000);
+        self.tick(ms_of_us(now_us));
         // The frame's EMCY, if it is one, is reported with the events below.
         let frame = self.node.poll(now_us);
         self.after_input(now_us);
