@@ -229,10 +229,17 @@ impl<T: OdValue, const N: usize> Array<T, N> {
     /// routes every sub-index of an array here, one arm per array).
     #[inline]
     pub fn sub(&mut self, sub: u8) -> Option<&mut dyn OdValue> {
-        match sub.checked_sub(1) {
-            None => Some(&mut self.sub0),
-            Some(i) => self.items.get_mut(usize::from(i)).map(|v| v as &mut dyn OdValue),
-        }
+        array_sub(&mut self.sub0, &mut self.items, sub)
+    }
+}
+
+/// [`Array::sub`] for any length: one copy per item type, not one per array object (the
+/// dispatch has one arm per array).
+#[inline(never)]
+fn array_sub<'a, T: OdValue>(sub0: &'a mut u8, items: &'a mut [T], sub: u8) -> Option<&'a mut dyn OdValue> {
+    match sub.checked_sub(1) {
+        None => Some(sub0),
+        Some(i) => items.get_mut(usize::from(i)).map(|v| v as &mut dyn OdValue),
     }
 }
 
@@ -316,10 +323,13 @@ pub trait Persistent {
 
 macro_rules! persistent_number {
     ($($t:ty),*) => {$(
+        // Out of line: records call these once per field.
         impl Persistent for $t {
+            #[inline(never)]
             fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
                 sink(at, &self.to_le_bytes())
             }
+            #[inline(never)]
             fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
                 let mut image = [0_u8; size_of::<$t>()];
                 let ok = source(at, &mut image);
