@@ -53,11 +53,15 @@ impl Indicators for OwnIndicators {
     fn show(&mut self, _: LedStates, _: u32) {}
 }
 
-/// Starts the device and serves it for ever. Not inlined: the device's handlers inlined here
-/// have frames of their own, which must not add to the frame that built the device.
+/// Starts the device and serves it for ever. `bxcan` comes disabled (off the bus) with its
+/// bit timing and filters set: it is enabled once the device's CAN side is
+/// active ([`Device::can_active`]: at once for most devices, after the host's enable command
+/// for CO401GW1). Not inlined: the device's handlers inlined here have frames of their own,
+/// which must not add to the frame that built the device.
 #[inline(never)]
 pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut indicators: impl Indicators) -> ! {
     device.start(0);
+    let mut on_bus = false;
     // A frame the mailboxes did not take (all three busy with frames of higher or equal
     // priority, or one bxcan took out to make room): sent before anything new is polled.
     let mut held: Option<bxcan::Frame> = None;
@@ -81,6 +85,14 @@ pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut indi
             while port.host_output(now_ms, &mut byte) == 1 {
                 let _ = nb::block!(host.write(byte[0]));
             }
+        }
+
+        if !on_bus && device.can_active() {
+            // Joins the bus once it sees 11 recessive bits, in the background: a bus held
+            // dominant must not stop the serial host. ABOM (set by `enable_non_blocking`)
+            // restarts after bus-off by itself.
+            let _ = bxcan.enable_non_blocking();
+            on_bus = true;
         }
 
         loop {

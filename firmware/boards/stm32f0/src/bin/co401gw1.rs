@@ -95,11 +95,9 @@ fn main() -> ! {
     let host = Serial::usart2(p.USART2, host_pins, baud.bps(), &mut rcc);
     let mut bxcan = bxcan::Can::builder(CanInstance::new(p.CAN, can_pins.0, can_pins.1, &mut rcc)).set_bit_timing(can::bit_timing(can_kbit)).leave_disabled();
     bxcan.modify_filters().enable_bank(0, Mask32::accept_all());
-    // Joins the bus once it sees 11 recessive bits, in the background: a bus held dominant at
-    // power-on must not stop the serial host. ABOM (set here) restarts after bus-off by itself.
-    // The chip itself stays off the bus (sends nothing, drops what it receives) until the host
-    // enables CAN.
-    let _ = bxcan.enable_non_blocking();
+    // `serve` enables the controller once the device's CAN side is active: for the chip, when
+    // the host enables CAN. Until then the controller stays off the bus (it neither
+    // acknowledges nor sends), as the chip's CAN side is off.
 
     serve(chip, host, bxcan, OwnIndicators)
 }
