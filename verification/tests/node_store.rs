@@ -137,3 +137,46 @@ fn saving_one_area_keeps_the_others_from_the_previous_block() {
     fresh.read(0x2180, 0, 0, &mut buf, Side::Device).expect("2180h exists");
     assert_eq!(u16::from_le_bytes(buf), 2000, "manufacturer area saved now");
 }
+
+/// A storage device that counts its writes.
+#[derive(Debug)]
+struct Counting {
+    image: RamEeprom<[u8; 2048]>,
+    writes: usize,
+}
+
+impl embedded_storage::ReadStorage for Counting {
+    type Error = ();
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), ()> {
+        self.image.read(offset, bytes).map_err(|_| ())
+    }
+    fn capacity(&self) -> usize {
+        self.image.capacity()
+    }
+}
+
+impl embedded_storage::Storage for Counting {
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), ()> {
+        self.writes += 1;
+        self.image.write(offset, bytes).map_err(|_| ())
+    }
+}
+
+#[test]
+fn a_save_gathers_the_entries_into_few_writes_of_the_same_bytes() {
+    use coforge_stack::od::NodeDictionary;
+    let od = od_with_guard_time(700);
+    let len = <Od<NoAppObjects> as NodeDictionary>::PERSISTENT_SIZE;
+    let mut expected = vec![0_u8; len];
+    assert!(od.save_area(Area::ALL, &mut |at, bytes| {
+        expected[at..at + bytes.len()].copy_from_slice(bytes);
+        true
+    }));
+    let mut store = BlockStore::new(Counting { image: RamEeprom::new(), writes: 0 }, 0);
+    store.save(&od, Area::ALL).expect("fits");
+    let Counting { image, writes } = store.into_inner();
+    // An EEPROM write cycle (some 5 ms) per write: two headers and the data gathered into
+    // pieces of up to 32 bytes (each more than 16 full), not one write per entry (272).
+    assert!(writes <= 2 + len.div_ceil(16), "{writes} writes for {len} bytes");
+    assert_eq!(&image.as_bytes()[12..12 + len], &expected[..], "the block's data as save_area gives it");
+}

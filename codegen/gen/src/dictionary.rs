@@ -138,8 +138,10 @@ struct Parts {
     names: Vec<Ident>,
     /// `(object number, sub) => &mut field` arms of `field`.
     field_arms: Vec<TokenStream>,
-    /// Persistent entries, saved by 1010h.
-    persist: Vec<Place>,
+    /// The persistent block, saved by 1010h: its units in block (index) order.
+    persist: Vec<Unit>,
+    /// Record types that implement `Persistent` (emitted once per type).
+    persistent_records: Vec<Ident>,
     /// Every stored entry (RAM and persistent): what an NMT reset sets back to its default.
     resets: Vec<Place>,
     /// Record types emitted so far, by shape (sub, field, type of each entry).
@@ -160,6 +162,22 @@ struct Place {
     per_mode: bool,
 }
 
+/// One unit of the persistent block: a field, an array's items, a whole array or a whole
+/// record, whose entries' images follow each other in the block.
+struct Unit {
+    /// The object index (every entry of a unit has the same).
+    index: TokenStream,
+    /// Where it lives in `Od`.
+    place: TokenStream,
+    /// Bytes of its image.
+    size: TokenStream,
+}
+
+/// The image size of one entry's field.
+fn image_size(ty: &TokenStream, stack: &TokenStream) -> TokenStream {
+    quote!(<#ty as #stack::value::Persist>::SIZE)
+}
+
 impl Place {
     fn new(number: u16, place: TokenStream, ty: TokenStream, default: TokenStream, per_mode: bool) -> Place {
         Place { number, index: crate::hex(number.into(), 4), place, ty, default, per_mode }
@@ -167,7 +185,10 @@ impl Place {
 }
 
 impl Parts {
-    fn place(&mut self, e: &Entry, number: u16, place: TokenStream, ty: TokenStream, defaults: ModeDefaults) {
+    /// A stored entry: reset by NMT resets, and a unit of the persistent block of its own
+    /// unless `grouped` (the caller saves it with others as one unit).
+    #[allow(clippy::too_many_arguments)]
+    fn place(&mut self, e: &Entry, number: u16, place: TokenStream, ty: TokenStream, defaults: ModeDefaults, grouped: bool, stack: &TokenStream) {
         let distinct: std::collections::BTreeSet<String> = defaults.iter().map(|(_, t)| t.to_string()).collect();
         let per_mode = distinct.len() > 1;
         let default = match defaults.as_slice() {
@@ -180,8 +201,8 @@ impl Parts {
             }
         };
         let p = Place::new(number, place, ty, default, per_mode);
-        if persistent(e) {
-            self.persist.push(p.clone());
+        if persistent(e) && !grouped {
+            self.persist.push(Unit { index: p.index.clone(), place: p.place.clone(), size: image_size(&p.ty, stack) });
         }
         self.resets.push(p);
     }
@@ -214,26 +235,41 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
                 return plain_field(kept[0], &field, &doc, slot.index, &number, stack, parts, defaults);
             };
             let ty = rust_type(first, stack);
-            if let Some(e) = kept.iter().find(|e| e.sub == 0) {
-                parts.place(e, slot.index, quote!(self.#field.sub0), quote!(u8), defaults(e.sub));
-            }
             let count = crate::dec(n as u64);
+            let sub0 = kept.iter().find(|e| e.sub == 0);
+            // Every item 1..=N persistent: the items are one unit, with sub 0 if it is
+            // persistent too (the same images at the same offsets as entry by entry).
+            let items_unit = items.len() == n && items.iter().all(|e| persistent(e));
+            let whole_unit = items_unit && sub0.is_some_and(|e| persistent(e));
+            if let Some(e) = sub0 {
+                parts.place(e, slot.index, quote!(self.#field.sub0), quote!(u8), defaults(e.sub), whole_unit, stack);
+            }
+            if items_unit {
+                let index = crate::hex(slot.index.into(), 4);
+                let item_size = image_size(&ty, stack);
+                parts.persist.push(if whole_unit {
+                    Unit { index, place: quote!(self.#field), size: quote!(1 + #item_size * #count) }
+                } else {
+                    Unit { index, place: quote!(self.#field.items), size: quote!(#item_size * #count) }
+                });
+            }
             let item_defaults: Vec<ModeDefaults> = items.iter().map(|e| defaults(e.sub)).collect();
             let texts: std::collections::BTreeSet<String> = item_defaults.iter().flatten().map(|(_, t)| t.to_string()).collect();
             match item_defaults.first().and_then(|d| d.first()) {
                 // Every item has one default in every mode: one array store resets them all
                 // (a fill, not one store per item); the store still saves item by item.
                 Some((_, default)) if texts.len() == 1 && items.len() == n => {
-                    for e in items.iter().filter(|e| persistent(e)) {
+                    for e in items.iter().filter(|e| persistent(e) && !items_unit) {
                         let i = crate::dec(u64::from(e.sub) - 1);
-                        parts.persist.push(Place::new(slot.index, quote!(self.#field.items[#i]), ty.clone(), default.clone(), false));
+                        let index = crate::hex(slot.index.into(), 4);
+                        parts.persist.push(Unit { index, place: quote!(self.#field.items[#i]), size: image_size(&ty, stack) });
                     }
                     parts.resets.push(Place::new(slot.index, quote!(self.#field.items), quote!([#ty; #count]), quote!([#default; #count]), false));
                 }
                 _ => {
                     for (e, d) in items.iter().zip(item_defaults) {
                         let i = crate::dec(u64::from(e.sub) - 1);
-                        parts.place(e, slot.index, quote!(self.#field.items[#i]), ty.clone(), d);
+                        parts.place(e, slot.index, quote!(self.#field.items[#i]), ty.clone(), d, items_unit, stack);
                     }
                 }
             }
@@ -246,11 +282,15 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
             let mut sub_fields = Vec::new();
             let mut sub_arms = Vec::new();
             let mut shape = String::new();
+            // Every stored entry persistent: the record is one unit of the block.
+            let record_unit = kept.iter().all(|e| persistent(e));
+            let mut unit_fields = Vec::new();
             for e in &kept {
                 let f = id(&e.ident);
                 let sub = crate::dec(e.sub.into());
                 let ty = rust_type(e, stack);
-                parts.place(e, slot.index, quote!(self.#field.#f), ty.clone(), defaults(e.sub));
+                parts.place(e, slot.index, quote!(self.#field.#f), ty.clone(), defaults(e.sub), record_unit, stack);
+                unit_fields.push((f.clone(), image_size(&ty, stack)));
                 let sdoc = format!(" Sub {}: {}", e.sub, e.name);
                 shape.push_str(&format!("{}:{f}:{ty};", e.sub));
                 sub_fields.push(quote!(#[doc = #sdoc] pub #f: #ty));
@@ -258,6 +298,37 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
             }
             // Records of one shape (the PDO parameter records) share one type and one
             // sub-index dispatch; the later ones are aliases of the first.
+            let record_type = parts.shapes.iter().find(|(s, _)| *s == shape).map_or(name.clone(), |(_, first)| first.clone());
+            if record_unit {
+                let index = crate::hex(slot.index.into(), 4);
+                let sizes = unit_fields.iter().map(|(_, size)| size);
+                parts.persist.push(Unit { index, place: quote!(self.#field), size: quote!(0 #(+ #sizes)*) });
+                if !parts.persistent_records.contains(&record_type) {
+                    parts.persistent_records.push(record_type.clone());
+                    let (names, sizes): (Vec<&Ident>, Vec<&TokenStream>) = unit_fields.iter().map(|(f, size)| (f, size)).unzip();
+                    parts.structs.push(quote! {
+                        /// The record's entries, one after the other in the persistent block.
+                        impl #stack::value::Persistent for #record_type {
+                            fn save_to(&self, mut at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+                                let mut ok = true;
+                                #(
+                                    ok &= #stack::value::Persistent::save_to(&self.#names, at, sink);
+                                    at += #sizes;
+                                )*
+                                ok
+                            }
+                            fn load_from(&mut self, mut at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+                                let mut ok = true;
+                                #(
+                                    ok &= #stack::value::Persistent::load_from(&mut self.#names, at, source);
+                                    at += #sizes;
+                                )*
+                                ok
+                            }
+                        }
+                    });
+                }
+            }
             match parts.shapes.iter().find(|(s, _)| *s == shape) {
                 Some((_, first)) => {
                     let alias = format!("{doc} (the same record as [`{first}`])");
@@ -303,7 +374,7 @@ fn plain_field(
     defaults: DefaultsOf<'_>,
 ) {
     let ty = rust_type(e, stack);
-    parts.place(e, index, quote!(self.#field), ty.clone(), defaults(e.sub));
+    parts.place(e, index, quote!(self.#field), ty.clone(), defaults(e.sub), false, stack);
     parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
     parts.names.push(field.clone());
     // The caller has found `sub` in this entry's run, so a single field needs no sub test.
@@ -352,6 +423,7 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
         names: Vec::new(),
         field_arms: Vec::new(),
         persist: Vec::new(),
+        persistent_records: Vec::new(),
         resets: Vec::new(),
         shapes: Vec::new(),
     };
@@ -360,8 +432,11 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
         slot_parts(&slot, stack, &mut parts, &defaults);
     }
     let Parts { structs, fields, names, field_arms, persist, resets, .. } = parts;
-    let (p_index, places): (Vec<&TokenStream>, Vec<&TokenStream>) = persist.iter().map(|p| (&p.index, &p.place)).unzip();
-    let types: Vec<&TokenStream> = persist.iter().map(|p| &p.ty).collect();
+    let p_index: Vec<&TokenStream> = persist.iter().map(|u| &u.index).collect();
+    let places: Vec<&TokenStream> = persist.iter().map(|u| &u.place).collect();
+    let sizes: Vec<&TokenStream> = persist.iter().map(|u| &u.size).collect();
+    let unit_numbers: Vec<proc_macro2::Literal> = (0..persist.len()).map(|n| crate::dec(n as u64)).collect();
+    let unit_count = crate::dec(persist.len() as u64);
     let reset_groups = reset_groups(&resets);
     // What `set_mode` sets: the entries whose default differs between modes.
     let (mode_targets, mode_values): (Vec<&TokenStream>, Vec<&TokenStream>) = resets.iter().filter(|p| p.per_mode).map(|p| (&p.place, &p.default)).unzip();
@@ -393,7 +468,30 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             pub fn mode(&self) -> Mode {
                 self.mode
             }
+
+            /// Unit `n` of the persistent block ([`PERSISTENT_UNITS`]).
+            #[allow(unreachable_code)]
+            fn persistent_unit(&self, n: usize) -> Option<&dyn #stack::value::Persistent> {
+                Some(match n {
+                    #(#unit_numbers => &#places,)*
+                    _ => return None,
+                })
+            }
+
+            /// Unit `n` of the persistent block, to load it.
+            #[allow(unreachable_code)]
+            fn persistent_unit_mut(&mut self, n: usize) -> Option<&mut dyn #stack::value::Persistent> {
+                Some(match n {
+                    #(#unit_numbers => &mut #places,)*
+                    _ => return None,
+                })
+            }
         }
+
+        /// The units of the persistent block (every `storage: persistent` entry, index order):
+        /// each one's index and image size. The store code walks this table once for every
+        /// unit instead of a copy of it per entry.
+        const PERSISTENT_UNITS: [(u16, u16); #unit_count] = [#((#p_index, (#sizes) as u16)),*];
 
         /// The node settings of the spec's `node:` section, for `node_id`.
         pub const fn node_config(node_id: u8) -> #stack::config::NodeConfig {
@@ -403,41 +501,30 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
         impl<A: #stack::od::AppObjects> #stack::od::NodeDictionary for Od<A> {
             type Mode = Mode;
             const MODES: &'static [Mode] = &Mode::ALL;
-            const PERSISTENT_SIZE: usize = 0 #(+ <#types as #stack::value::Persist>::SIZE)*;
+            const PERSISTENT_SIZE: usize = 0 #(+ #sizes)*;
             const SDO_BLOCK_TRANSFER: bool = #block_transfer;
             const COMM: #stack::od::CommObjects =
                 #stack::od::CommObjects { error_history: #history, sync_cycle: #sync_cycle, heartbeat_consumer: #consumer };
 
-            #[allow(unused_mut, unused_variables)]
             fn save_area(&self, area: #stack::od::Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-                use #stack::value::Persist as _;
                 let (mut at, mut ok) = (0, true);
-                #(
-                    if area.contains(#p_index) {
-                        let mut image = [0_u8; <#types as #stack::value::Persist>::SIZE];
-                        #places.save(&mut image);
-                        ok &= sink(at, &image);
+                for (n, &(index, size)) in PERSISTENT_UNITS.iter().enumerate() {
+                    if area.contains(index) {
+                        ok &= self.persistent_unit(n).is_some_and(|unit| unit.save_to(at, sink));
                     }
-                    at += <#types as #stack::value::Persist>::SIZE;
-                )*
+                    at += usize::from(size);
+                }
                 ok
             }
 
-            #[allow(unused_mut, unused_variables)]
             fn load_area(&mut self, area: #stack::od::Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-                use #stack::value::Persist as _;
                 let (mut at, mut ok) = (0, true);
-                #(
-                    if area.contains(#p_index) {
-                        let mut image = [0_u8; <#types as #stack::value::Persist>::SIZE];
-                        if source(at, &mut image) {
-                            #places.load(&image);
-                        } else {
-                            ok = false;
-                        }
+                for (n, &(index, size)) in PERSISTENT_UNITS.iter().enumerate() {
+                    if area.contains(index) {
+                        ok &= self.persistent_unit_mut(n).is_some_and(|unit| unit.load_from(at, source));
                     }
-                    at += <#types as #stack::value::Persist>::SIZE;
-                )*
+                    at += usize::from(size);
+                }
                 ok
             }
 

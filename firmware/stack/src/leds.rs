@@ -1,6 +1,8 @@
 //! CiA 303-3 indicator states: what the run and error LEDs show, as levels the board puts on
 //! its pins.
 
+use crate::time::div_rem_u64;
+
 /// A CiA 303-3 LED pattern.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LedState {
@@ -19,21 +21,35 @@ pub enum LedState {
 }
 
 impl LedState {
-    /// Whether the LED is lit `now_ms` after an arbitrary epoch.
+    /// Whether the LED is lit `now_ms` after an arbitrary epoch. (The remainder is taken by
+    /// [`div_rem_u64`]: no 64-bit division on a Cortex-M0.)
     pub const fn level(self, now_ms: u64) -> bool {
-        let flashes = match self {
-            LedState::Off => return false,
-            LedState::On => return true,
-            LedState::Flickering => return now_ms % 100 < 50,
-            LedState::Blinking => return now_ms % 400 < 200,
-            LedState::SingleFlash => 1,
-            LedState::DoubleFlash => 2,
-            LedState::TripleFlash => 3,
-        };
-        // n flashes of 200 ms on / 200 ms off, the last off phase stretched to 1000 ms.
-        let period = flashes * 400 + 800;
-        let t = now_ms % period;
-        t < flashes * 400 && t % 400 < 200
+        self.level_in_period(div_rem_u64(now_ms, self.period()).1)
+    }
+
+    /// The pattern's period in ms (1 for the steady states).
+    pub const fn period(self) -> u16 {
+        match self {
+            LedState::Off | LedState::On => 1,
+            LedState::Flickering => 100,
+            LedState::Blinking => 400,
+            // n flashes of 200 ms on / 200 ms off, the last off phase stretched to 1000 ms.
+            LedState::SingleFlash => 1200,
+            LedState::DoubleFlash => 1600,
+            LedState::TripleFlash => 2000,
+        }
+    }
+
+    /// Whether the LED is lit `t` ms into its period (`t` < [`period`](Self::period)): a
+    /// board that keeps its milliseconds in 32 bits takes the remainder itself.
+    pub const fn level_in_period(self, t: u32) -> bool {
+        match self {
+            LedState::Off => false,
+            LedState::On => true,
+            LedState::Flickering => t < 50,
+            LedState::Blinking => t < 200,
+            LedState::SingleFlash | LedState::DoubleFlash | LedState::TripleFlash => t < self.period() as u32 - 800 && t % 400 < 200,
+        }
     }
 }
 
@@ -47,6 +63,33 @@ pub struct Leds {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_level_is_the_level_in_the_period_on_any_clock() {
+        // The 64-bit clock's patterns, computed with u64 remainders, as they always were.
+        fn reference(s: LedState, now_ms: u64) -> bool {
+            let flashes = match s {
+                LedState::Off => return false,
+                LedState::On => return true,
+                LedState::Flickering => return now_ms % 100 < 50,
+                LedState::Blinking => return now_ms % 400 < 200,
+                LedState::SingleFlash => 1,
+                LedState::DoubleFlash => 2,
+                LedState::TripleFlash => 3,
+            };
+            let t = now_ms % (flashes * 400 + 800);
+            t < flashes * 400 && t % 400 < 200
+        }
+        let all = [LedState::Off, LedState::On, LedState::Flickering, LedState::Blinking, LedState::SingleFlash, LedState::DoubleFlash, LedState::TripleFlash];
+        for s in all {
+            for base in [0, 1 << 32, u64::MAX - 5000, 123_456_789_012] {
+                for t in (0..4000).map(|t| base.wrapping_add(t)) {
+                    assert_eq!(s.level(t), reference(s, t), "{s:?} at {t}");
+                    assert_eq!(s.level_in_period((t % u64::from(s.period())) as u32), reference(s, t));
+                }
+            }
+        }
+    }
 
     #[test]
     fn patterns_follow_cia_303_3_timing() {

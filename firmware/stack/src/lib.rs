@@ -31,5 +31,5 @@ pub mod pdo;
 pub(crate) mod ring;
 pub mod sdo;
 pub mod store;
-pub(crate) mod time;
+pub mod time;
 pub mod value;

@@ -181,6 +181,53 @@ impl<S: Storage> BlockStore<S> {
     }
 }
 
+/// Bytes a save gathers into one storage write.
+const GATHER: usize = 32;
+
+/// Consecutive pieces of a block being saved, written together once the next piece does not
+/// follow them or does not fit.
+struct Gather<'a, S> {
+    storage: &'a mut S,
+    /// Where the gathered bytes go, and how many there are.
+    at: u32,
+    len: usize,
+    buf: [u8; GATHER],
+    /// A write failed.
+    failed: bool,
+}
+
+impl<S: Storage> Gather<'_, S> {
+    /// Takes the piece `bytes` for `at`; `false` once a write has failed.
+    fn put(&mut self, at: u32, bytes: &[u8]) -> bool {
+        let follows = u32::try_from(self.len).ok().and_then(|len| self.at.checked_add(len)) == Some(at);
+        match self.buf.get_mut(self.len..self.len + bytes.len()) {
+            Some(dst) if follows => dst.copy_from_slice(bytes),
+            _ => {
+                self.flush();
+                match self.buf.get_mut(..bytes.len()) {
+                    Some(dst) => dst.copy_from_slice(bytes),
+                    // Longer than the buffer: written as it is.
+                    None => {
+                        self.failed |= self.storage.write(at, bytes).is_err();
+                        return !self.failed;
+                    }
+                }
+                self.at = at;
+            }
+        }
+        self.len += bytes.len();
+        !self.failed
+    }
+
+    /// Writes what is gathered.
+    fn flush(&mut self) {
+        if let Some(bytes) = self.buf.get(..self.len).filter(|b| !b.is_empty()) {
+            self.failed |= self.storage.write(self.at, bytes).is_err();
+        }
+        self.len = 0;
+    }
+}
+
 /// Where byte `offset` of the data of the slot at `slot_at` lives.
 fn data_at(slot_at: u32, offset: usize) -> Result<u32, StoreError> {
     slot_at.checked_add(HEADER).and_then(|d| d.checked_add(u32::try_from(offset).ok()?)).ok_or(StoreError::TooSmall)
@@ -208,13 +255,13 @@ impl<S: Storage> ParamStore for BlockStore<S> {
             // Without a valid block there is nothing to keep: store every area.
             _ => Area::ALL,
         };
-        let mut failed = false;
-        let written = od.save_area(area, &mut |offset, image| {
-            let ok = data_at(target, offset).is_ok_and(|at| self.storage.write(at, image).is_ok());
-            failed |= !ok;
-            ok
-        });
-        if !written || failed {
+        // The entries' images come a few bytes at a time: gathered into writes of up to
+        // `GATHER` bytes, so an EEPROM spends one write cycle (some 5 ms) per gathered piece,
+        // not one per entry (a 541-byte block of 272 entries took 1.4 s).
+        let mut gather = Gather { storage: &mut self.storage, at: 0, len: 0, buf: [0; GATHER], failed: false };
+        let written = od.save_area(area, &mut |offset, image| data_at(target, offset).is_ok_and(|at| gather.put(at, image)));
+        gather.flush();
+        if !written || gather.failed {
             return Err(StoreError::Device);
         }
         let seq = newest.map_or(1, |n| n.seq.wrapping_add(1));

@@ -229,10 +229,17 @@ impl<T: OdValue, const N: usize> Array<T, N> {
     /// routes every sub-index of an array here, one arm per array).
     #[inline]
     pub fn sub(&mut self, sub: u8) -> Option<&mut dyn OdValue> {
-        match sub.checked_sub(1) {
-            None => Some(&mut self.sub0),
-            Some(i) => self.items.get_mut(usize::from(i)).map(|v| v as &mut dyn OdValue),
-        }
+        array_sub(&mut self.sub0, &mut self.items, sub)
+    }
+}
+
+/// [`Array::sub`] for any length: one copy per item type, not one per array object (the
+/// dispatch has one arm per array).
+#[inline(never)]
+fn array_sub<'a, T: OdValue>(sub0: &'a mut u8, items: &'a mut [T], sub: u8) -> Option<&'a mut dyn OdValue> {
+    match sub.checked_sub(1) {
+        None => Some(sub0),
+        Some(i) => items.get_mut(usize::from(i)).map(|v| v as &mut dyn OdValue),
     }
 }
 
@@ -297,6 +304,106 @@ impl<const N: usize> Persist for Bytes<N> {
             self.bytes.copy_from_slice(b);
             self.len = len;
         }
+    }
+}
+
+/// One unit of the persistent block as the generated `save_area`/`load_area` walk it: a field,
+/// an array's items, a whole array or a whole record, each handing its entries' images over
+/// one by one at their offsets (the same pieces, in the same order, as a walk entry by entry).
+/// Object-safe, so a dictionary names its units in one `match` instead of unrolling a copy of
+/// the store code per entry.
+pub trait Persistent {
+    /// Hands the image of every entry of the unit to `sink`, the first at offset `at`; `false`
+    /// if `sink` refused one (the rest are still handed over).
+    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool;
+    /// Loads every entry of the unit from `source`, the first at offset `at`; an entry whose
+    /// image `source` cannot give keeps its value, and the result is `false`.
+    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool;
+}
+
+macro_rules! persistent_number {
+    ($($t:ty),*) => {$(
+        // Out of line: records call these once per field.
+        impl Persistent for $t {
+            #[inline(never)]
+            fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+                sink(at, &self.to_le_bytes())
+            }
+            #[inline(never)]
+            fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+                let mut image = [0_u8; size_of::<$t>()];
+                let ok = source(at, &mut image);
+                if ok {
+                    *self = <$t>::from_le_bytes(image);
+                }
+                ok
+            }
+        }
+    )*};
+}
+
+persistent_number!(u8, u16, u32, u64, i8, i16, i32, i64, f32, f64);
+
+impl Persistent for bool {
+    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+        sink(at, &[u8::from(*self)])
+    }
+    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+        let mut image = [0_u8; 1];
+        let ok = source(at, &mut image);
+        if ok {
+            self.load(&image);
+        }
+        ok
+    }
+}
+
+/// The length (2 bytes), then the `N` bytes: [`Persist`]'s image, in two pieces.
+impl<const N: usize> Persistent for Bytes<N> {
+    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+        let len = u16::try_from(self.len).unwrap_or(u16::MAX);
+        let ok = sink(at, &len.to_le_bytes());
+        sink(at + 2, &self.bytes) && ok
+    }
+    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+        let (mut len, mut bytes) = ([0_u8; 2], [0_u8; N]);
+        let ok = source(at, &mut len) && source(at + 2, &mut bytes);
+        let len = usize::from(u16::from_le_bytes(len));
+        // A corrupt length leaves the value as it was.
+        if ok && len <= N {
+            (self.bytes, self.len) = (bytes, len);
+        }
+        ok
+    }
+}
+
+/// An array's items 1..=N, each [`Persist::SIZE`] bytes.
+impl<T: Persist + Persistent, const N: usize> Persistent for [T; N] {
+    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+        let mut ok = true;
+        for (i, item) in self.iter().enumerate() {
+            ok &= item.save_to(at + i * T::SIZE, sink);
+        }
+        ok
+    }
+    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+        let mut ok = true;
+        for (i, item) in self.iter_mut().enumerate() {
+            ok &= item.load_from(at + i * T::SIZE, source);
+        }
+        ok
+    }
+}
+
+/// A whole array: sub 0, then the items.
+impl<T: Persist + Persistent, const N: usize> Persistent for Array<T, N> {
+    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+        let ok = self.sub0.save_to(at, sink);
+        self.items.save_to(at + 1, sink) && ok
+    }
+    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+        let ok = self.sub0.load_from(at, source);
+        self.items.load_from(at + 1, source) && ok
     }
 }
 

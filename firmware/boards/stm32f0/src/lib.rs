@@ -34,13 +34,38 @@
 //!
 //! The datasheet's inversions (ID, BD, RSBD and CFG active low) are applied by the device
 //! crate's decoders: [`board::ConfigWord`] hands over raw levels.
+//!
+//! # CO401GW1 on the STM32F042C6 (LQFP48)
+//!
+//! The same die in 48 pins (`src/bin/co401gw1.rs`, [`gw1`]; `PINS-co401gw1.md` has the
+//! reasons, the straps and the parameter store). Its 40 signals need 7 more pins than the
+//! 33 left after SWD, the crystal and BOOT0, so ID, BD and RSBD (read only at reset) go
+//! through the same two 74HC165 as above; CFG0..CFG2 are read at reset and then drive the
+//! LEDs and the watchdog. 1010h/1011h store into a 24C128 at 0x50. Not in dist yet: it does
+//! not fit the 32 KiB (feature `co401gw1-image`).
+//!
+//! | Signal (datasheet) | STM32F042C6 pin (LQFP48 no.) | Use |
+//! |---|---|---|
+//! | CANRX / CANTX | PA11 (32) / PA12 (33) | CAN_RX / CAN_TX, AF4 |
+//! | RSRXD / RSTXD | PA3 (13) / PA2 (12) | USART2_RX / USART2_TX, AF1 |
+//! | EEPROM SCL / SDA | PB6 (42) / PB7 (43) | I2C1, AF1, open drain; 24C128 at 0x50 |
+//! | IN0..IN7 | PA0 (10), PA1 (11), PA4..PA9 (14..17, 29, 30) | inputs with pull-up, active low |
+//! | EMY0# / EMY1# | PA10 (31) / PA15 (38) | inputs with pull-up, active low |
+//! | OUT0..OUT7 | PB8 (45), PB9 (46), PB10 (21), PB11 (22), PB12..PB15 (25..28) | push-pull, active low |
+//! | CFG0/R, CFG1/E, CFG2/WD | PB0 (18), PB1 (19), PB2 (20) | strap inputs at reset, then push-pull outputs: run LED, error LED, watchdog |
+//! | 74HC165 CLK, SH/LD#, QH | PB3 (39), PB4 (40), PB5 (41) | ID0..ID6 on U1 A..G; BD0..BD2, RSBD0..RSBD2 on U2 A..F |
+//! | 8 MHz crystal | PF0 (5) / PF1 (6) | HSE, PLL x6 = 48 MHz |
+//! | SWDIO / SWCLK | PA13 (34) / PA14 (37) | debug, flashing |
+//! | spare | PC13 (2), PC14 (3), PC15 (4) | |
 #![no_std]
-// One read of a status register (`serve::esr`) is the only `unsafe`.
+// One read of a status register (`serve::esr`) and the GW1 board's port registers
+// (`gw1::Ports`) are the only `unsafe`.
 #![deny(unsafe_code)]
 #![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
 
 pub mod board;
 pub mod can;
 pub mod clock;
+pub mod gw1;
 pub mod i2c;
 pub mod serve;

@@ -1,8 +1,10 @@
 //! The main loop, for any device: its serial host port (if it has one) on USART2, its CAN
-//! side on bxCAN, its CiA 303-3 indicators on the two LEDs.
+//! side on bxCAN, its CiA 303-3 indicators on two LEDs ([`Indicators`]: the loop's, or the
+//! device's own when it drives them through its board, as CO401GW1 does).
 
 use crate::{can, clock};
 use coforge_stack::device::Device;
+use coforge_stack::leds::{LedState, Leds as LedStates};
 use coforge_stack::node::BusState;
 use embedded_hal_02::digital::v2::OutputPin;
 use embedded_hal_02::serial::{Read, Write};
@@ -21,11 +23,45 @@ pub type Can = bxcan::Can<CanInstance<PA12<Alternate<AF4>>, PA11<Alternate<AF4>>
 /// CANLEDR#, CANLEDE#.
 pub type Leds = (PB0<Output<PushPull>>, PB1<Output<PushPull>>);
 
-/// Starts the device and serves it for ever. Not inlined: the device's handlers inlined here
-/// have frames of their own, which must not add to the frame that built the device.
+/// What shows the device's CiA 303-3 indicators once per pass of the loop.
+pub trait Indicators {
+    /// Shows `states` at `ms`, the millisecond clock's low 32 bits.
+    fn show(&mut self, states: LedStates, ms: u32);
+}
+
+/// Two active-low LEDs (run, error) driven from [`Device::leds`]: CO401Memory1's CANLEDR# and
+/// CANLEDE#.
+impl Indicators for Leds {
+    #[inline(always)]
+    fn show(&mut self, states: LedStates, ms: u32) {
+        // The milliseconds' low 32 bits: a u64 here would take a 64-bit remainder for the
+        // patterns' periods; the wrap after 49 days only shifts a flash phase once.
+        let level = |s: LedState| s.level_in_period(ms % u32::from(s.period()));
+        let _ = self.0.set_state((!level(states.run)).into());
+        let _ = self.1.set_state((!level(states.error)).into());
+    }
+}
+
+/// A device that drives its indicators itself, through its own board, whenever it handles an
+/// input or a poll (CO401GW1: CFG0/R, CFG1/E and CFG2/WD, with its own run-LED flicker): the
+/// loop has nothing to show.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct OwnIndicators;
+
+impl Indicators for OwnIndicators {
+    #[inline(always)]
+    fn show(&mut self, _: LedStates, _: u32) {}
+}
+
+/// Starts the device and serves it for ever. `bxcan` comes disabled (off the bus) with its
+/// bit timing and filters set: it is enabled once the device's CAN side is
+/// active ([`Device::can_active`]: at once for most devices, after the host's enable command
+/// for CO401GW1). Not inlined: the device's handlers inlined here have frames of their own,
+/// which must not add to the frame that built the device.
 #[inline(never)]
-pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut leds: Leds) -> ! {
+pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut indicators: impl Indicators) -> ! {
     device.start(0);
+    let mut on_bus = false;
     // A frame the mailboxes did not take (all three busy with frames of higher or equal
     // priority, or one bxcan took out to make room): sent before anything new is polled.
     let mut held: Option<bxcan::Frame> = None;
@@ -49,6 +85,14 @@ pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut leds
             while port.host_output(now_ms, &mut byte) == 1 {
                 let _ = nb::block!(host.write(byte[0]));
             }
+        }
+
+        if !on_bus && device.can_active() {
+            // Joins the bus once it sees 11 recessive bits, in the background: a bus held
+            // dominant must not stop the serial host. ABOM (set by `enable_non_blocking`)
+            // restarts after bus-off by itself.
+            let _ = bxcan.enable_non_blocking();
+            on_bus = true;
         }
 
         loop {
@@ -78,12 +122,7 @@ pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut leds
             held = can::to_bxcan(&frame).and_then(|f| transmit(&mut bxcan, f));
         }
 
-        // The milliseconds' low 32 bits: a u64 here would link a 64-bit division (about 1 KiB)
-        // for the patterns' periods; the wrap after 49 days only shifts a flash phase once.
-        let ms = u64::from(now_ms as u32);
-        let indicators = device.leds();
-        let _ = leds.0.set_state((!indicators.run.level(ms)).into());
-        let _ = leds.1.set_state((!indicators.error.level(ms)).into());
+        indicators.show(device.leds(), now_ms as u32);
     }
 }
 

@@ -23,6 +23,7 @@ use coforge_stack::node::{BusState, NodeEvent};
 use coforge_stack::od::{EntryAccess, NodeDictionary, Side};
 use coforge_stack::pdo::Dir;
 use coforge_stack::store::{BlockStore, ParamStore};
+use coforge_stack::time::{div_rem_u64, ms_of_us};
 use heapless::Deque;
 
 /// Bytes waiting for the host: two of the longest telegrams (an emergency report is 10 bytes,
@@ -231,7 +232,8 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
             return (false, false);
         }
         let Leds { run, error } = self.node.leds();
-        let run_lit = if run == LedState::On && self.node.state() == NmtState::Operational { now_ms % 200 >= 10 } else { run.level(now_ms) };
+        let operational = run == LedState::On && self.node.state() == NmtState::Operational;
+        let run_lit = if operational { div_rem_u64(now_ms, 200).1 >= 10 } else { run.level(now_ms) };
         (run_lit, error.level(now_ms))
     }
 
@@ -381,15 +383,16 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
     fn take_node_events(&mut self) {
         // Most inputs raise no event: nothing to gather, nothing to update again.
         let Some(first) = self.node.take_event() else { return };
-        let mut events: heapless::Vec<NodeEvent, EVENTS> = heapless::Vec::new();
-        let _ = events.push(first);
+        // The newest EVENTS: a ring, not a `Vec` whose `remove(0)` would link `memmove`.
+        let mut events: Deque<NodeEvent, EVENTS> = Deque::new();
+        let _ = events.push_back(first);
         while let Some(event) = self.node.take_event() {
             if events.is_full() {
-                events.remove(0);
+                events.pop_front();
             }
-            let _ = events.push(event);
+            let _ = events.push_back(event);
         }
-        if events.contains(&NodeEvent::ResetApplication) {
+        if events.iter().any(|e| *e == NodeEvent::ResetApplication) {
             self.node.od_mut().app.outputs = [0; IMAGE];
         }
         let reset = events.iter().any(|e| matches!(e, NodeEvent::ResetApplication | NodeEvent::ResetCommunication));
@@ -548,8 +551,8 @@ impl<B: Board, S: ParamStore> Device for Gw1<B, S> {
     fn start(&mut self, now_us: u64) {
         self.node.power_on(now_us);
         self.after_reset();
-        self.phase = Phase::Boot { next_bootup_ms: now_us / 1000 };
-        self.tick(now_us / 1000);
+        self.phase = Phase::Boot { next_bootup_ms: ms_of_us(now_us) };
+        self.tick(ms_of_us(now_us));
         self.after_input(now_us);
     }
 
@@ -560,7 +563,7 @@ impl<B: Board, S: ParamStore> Device for Gw1<B, S> {
     }
 
     fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
-        self.tick(now_us / 1000);
+        self.tick(ms_of_us(now_us));
         // The frame's EMCY, if it is one, is reported with the events below.
         let frame = self.node.poll(now_us);
         self.after_input(now_us);
@@ -593,6 +596,11 @@ impl<B: Board, S: ParamStore> Device for Gw1<B, S> {
 
     fn host_port(&mut self) -> Option<&mut dyn HostPort> {
         Some(self)
+    }
+
+    /// Off the bus until the host enables CAN (`02 00`/`02 81`).
+    fn can_active(&self) -> bool {
+        self.node.can_enabled()
     }
 }
 

@@ -87,9 +87,7 @@ fn main() -> ! {
         .set_bit_timing(can::bit_timing(config.can_bitrate_kbit))
         .leave_disabled();
     bxcan.modify_filters().enable_bank(0, Mask32::accept_all());
-    // Joins the bus once it sees 11 recessive bits, in the background: a bus held dominant at
-    // power-on must not stop the serial host. ABOM (set here) restarts after bus-off by itself.
-    let _ = bxcan.enable_non_blocking();
+    // `serve` enables the controller once the device's CAN side is active (at once here).
 
     serve(device, host, bxcan, leds)
 }
