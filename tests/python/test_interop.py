@@ -500,7 +500,7 @@ def test_sdo_segmented_download_of_shorter_string(start):
     assert dev.node.sdo[0x2000].raw == "SHORT"
 
 
-@pytest.mark.parametrize("name", ["co401gw1", "cr3101", "canopenia"])
+@pytest.mark.parametrize("name", ["cr3101", "canopenia"])
 def test_sdo_block_upload(start, name):
     dev = start(name)
     expected = dev.entry(0x1008)["default"].encode()
@@ -517,11 +517,8 @@ def test_sdo_block_upload(start, name):
     [
         # An 11-byte VISIBLE_STRING (cr3101 2000h): two segments, CRC over all 11 bytes.
         ("cr3101", 0x2000, 0, b"BLOCKXFER11"),
-        # co401gw1 has no writable entry of 8 bytes or more: a 4-byte INTEGER32 (6424h sub 1)
-        # still exercises initiate, one segment, end with CRC.
-        ("co401gw1", 0x6424, 1, (0x12345678).to_bytes(4, "little")),
     ],
-    ids=["cr3101-2000-string11", "co401gw1-6424.1-int32"],
+    ids=["cr3101-2000-string11"],
 )
 def test_sdo_block_download_and_upload(start, name, index, sub, data):
     dev = start(name)
@@ -534,6 +531,19 @@ def test_sdo_block_download_and_upload(start, name, index, sub, data):
     assert dev.read(index, sub) == data
     with dev.node.sdo.open(index, sub, "rb", block_transfer=True) as f:
         assert f.read() == data
+
+
+def test_co401gw1_refuses_block_transfer(start):
+    """GW1-63: no block transfer; a block initiate is aborted with 0504 0001h, and segmented
+    transfers still work."""
+    dev = start("co401gw1")
+    for request in ([0xA0, 0x08, 0x10, 0x00, 0x7F, 0, 0, 0], [0xC6, 0x24, 0x64, 0x01, 4, 0, 0, 0]):
+        mark = dev.rec.mark()
+        dev.net.send_message(0x600 + dev.node_id, bytes(request))
+        answer = dev.rec.wait(dev.sdo_tx_cob, mark, 2.0)
+        assert answer is not None and answer.data[0] == 0x80, f"abort expected: {answer}"
+        assert int.from_bytes(answer.data[4:8], "little") == 0x05040001
+    assert dev.read(0x1008) == dev.entry(0x1008)["default"].encode()
 
 
 # ============================================================================================
