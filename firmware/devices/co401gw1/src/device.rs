@@ -72,6 +72,9 @@ pub struct Gw1<B, S> {
     events: Deque<NodeEvent, EVENTS>,
     watchdog: bool,
     next_watchdog_ms: u64,
+    /// The millisecond the LEDs and the watchdog pin were last driven for: once per
+    /// millisecond is all a LED pattern or a 10 ms watchdog needs.
+    shown_ms: u64,
     /// The time of the latest input.
     now_us: u64,
     /// Host telegrams refused: not a command, not allowed now, or refused by the dictionary
@@ -106,6 +109,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
             events: Deque::new(),
             watchdog: false,
             next_watchdog_ms: 0,
+            shown_ms: u64::MAX,
             now_us: 0,
             host_refusals: 0,
         }
@@ -220,6 +224,10 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
             self.next_watchdog_ms = now_ms.saturating_add(WATCHDOG_PERIOD_MS);
             self.watchdog = !self.watchdog;
         }
+        if now_ms == self.shown_ms {
+            return;
+        }
+        self.shown_ms = now_ms;
         let (run, error) = self.indicators(now_ms);
         self.board.set_indicators(run, error, self.watchdog);
     }
