@@ -124,8 +124,9 @@ class Target(Sim):
         if kind == "sim":
             super().__init__("mixed", ["--store", str(workdir / PARAMS)])
             return
-        # As Sim.__init__, over QEMU and the hub.
+        # As Sim.__init__, over QEMU and the hub (the image's ID pins select NODE_ID).
         self.mode = "mixed"
+        self.node_id = NODE_ID
         od = dictionary(self.mode)
         self.net = self.host = None
         self.sim = QemuProcess(workdir)
@@ -136,7 +137,7 @@ class Target(Sim):
             self.net.listeners.insert(0, self.rec)
             self.net.connect(interface="slcan", channel=self.sim.can_url, sleep_after_open=0, bitrate=500000)
             self._bus_ready(self.sim.can_url)
-            self.node = canopen.RemoteNode(NODE_ID, od)
+            self.node = canopen.RemoteNode(self.node_id, od)
             self.node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
             self.net.add_node(self.node)
             self.host = Host(self.sim.serial_url)
