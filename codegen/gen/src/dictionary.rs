@@ -87,8 +87,9 @@ pub(crate) fn rust_type(e: &Entry, stack: &TokenStream) -> TokenStream {
 fn initial(e: &Entry, stack: &TokenStream) -> TokenStream {
     let ty = rust_type(e, stack);
     match (&e.default, e.data_type) {
-        (Some(Value::Str(s)), _) => quote!(#stack::value::Bytes::new(#s)),
-        (_, t) if t.int_range().is_none() && !t.is_real() => quote!(#stack::value::Bytes::new("")),
+        // Evaluated at compile time: a copy from flash, not a call that fills the text in.
+        (Some(Value::Str(s)), _) => quote!(const { #stack::value::Bytes::new(#s) }),
+        (_, t) if t.int_range().is_none() && !t.is_real() => quote!(const { #stack::value::Bytes::new("") }),
         (Some(Value::Real(x)), _) => quote!(#x as #ty),
         (None, DataType::Boolean) => quote!(false),
         (Some(Value::Int(expr)), DataType::Boolean) => {
@@ -285,6 +286,7 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
             // Every stored entry persistent: the record is one unit of the block.
             let record_unit = kept.iter().all(|e| persistent(e));
             let mut unit_fields = Vec::new();
+            let first_reset = parts.resets.len();
             for e in &kept {
                 let f = id(&e.ident);
                 let sub = crate::dec(e.sub.into());
@@ -295,6 +297,26 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
                 shape.push_str(&format!("{}:{f}:{ty};", e.sub));
                 sub_fields.push(quote!(#[doc = #sdoc] pub #f: #ty));
                 sub_arms.push(quote!(#sub => &mut self.#f));
+            }
+            // One store of a constant record (a copy from flash) resets the record, not one
+            // store per entry; defaults that depend on the mode or the node-ID (integers,
+            // 0 in the constant) are stored after it.
+            let record_resets = parts.resets.split_off(first_reset);
+            let varies = |p: &Place| p.per_mode || p.default.to_string().contains("node_id");
+            let integer = |p: &Place| ["u8", "u16", "u32", "u64", "i8", "i16", "i32", "i64"].contains(&p.ty.to_string().as_str());
+            if record_resets.iter().all(|p| !varies(p) || integer(p)) && record_resets.iter().filter(|p| !varies(p)).count() > 1 {
+                let names = kept.iter().map(|e| id(&e.ident));
+                let values = record_resets.iter().map(|p| if varies(p) { quote!(0) } else { p.default.clone() });
+                parts.resets.push(Place::new(
+                    slot.index,
+                    quote!(self.#field),
+                    quote!(#name),
+                    quote!({ const DEFAULT: #name = #name { #(#names: #values),* }; DEFAULT }),
+                    false,
+                ));
+                parts.resets.extend(record_resets.into_iter().filter(varies));
+            } else {
+                parts.resets.extend(record_resets);
             }
             // Records of one shape (the PDO parameter records) share one type and one
             // sub-index dispatch; the later ones are aliases of the first.
@@ -437,9 +459,11 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let sizes: Vec<&TokenStream> = persist.iter().map(|u| &u.size).collect();
     let unit_numbers: Vec<proc_macro2::Literal> = (0..persist.len()).map(|n| crate::dec(n as u64)).collect();
     let unit_count = crate::dec(persist.len() as u64);
+    // The entries whose default differs between modes are reset by one function, which
+    // `set_mode` calls too.
+    let (mode_resets, resets): (Vec<Place>, Vec<Place>) = resets.into_iter().partition(|p| p.per_mode);
+    let mode_groups = reset_groups(&mode_resets);
     let reset_groups = reset_groups(&resets);
-    // What `set_mode` sets: the entries whose default differs between modes.
-    let (mode_targets, mode_values): (Vec<&TokenStream>, Vec<&TokenStream>) = resets.iter().filter(|p| p.per_mode).map(|p| (&p.place, &p.default)).unzip();
     let node_config = node_config(d, stack);
     quote! {
         #(#structs)*
@@ -467,6 +491,13 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
 
             pub fn mode(&self) -> Mode {
                 self.mode
+            }
+
+            /// The defaults that differ between modes, in `area`: what `set_mode` sets (in
+            /// every area) and `reset_area` (after the others).
+            #[allow(unused_variables)]
+            fn reset_mode_defaults(&mut self, area: #stack::od::Area, node_id: u8) {
+                #(#mode_groups)*
             }
 
             /// Unit `n` of the persistent block ([`PERSISTENT_UNITS`]).
@@ -531,6 +562,7 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             #[allow(unused_variables)]
             fn reset_area(&mut self, area: #stack::od::Area, node_id: u8) {
                 #(#reset_groups)*
+                self.reset_mode_defaults(area, node_id);
             }
 
             fn emergencies(&self) -> &'static [#stack::emcy::EmcyDefault] {
@@ -552,7 +584,7 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             #[allow(unused_variables)]
             fn set_mode(&mut self, mode: Mode, node_id: u8) {
                 self.mode = mode;
-                #(#mode_targets = #mode_values;)*
+                self.reset_mode_defaults(#stack::od::Area::ALL, node_id);
             }
 
             fn mode_name(mode: Mode) -> &'static str {
