@@ -331,21 +331,11 @@ fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults:
                     parts.structs.push(quote! {
                         /// The record's entries, one after the other in the persistent block.
                         impl #stack::value::Persistent for #record_type {
-                            fn save_to(&self, mut at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-                                let mut ok = true;
-                                #(
-                                    ok &= #stack::value::Persistent::save_to(&self.#names, at, sink);
-                                    at += #sizes;
-                                )*
-                                ok
+                            fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+                                #stack::value::save_fields(&[#((&self.#names, #sizes)),*], at, sink)
                             }
-                            fn load_from(&mut self, mut at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-                                let mut ok = true;
-                                #(
-                                    ok &= #stack::value::Persistent::load_from(&mut self.#names, at, source);
-                                    at += #sizes;
-                                )*
-                                ok
+                            fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+                                #stack::value::load_fields(&mut [#((&mut self.#names, #sizes)),*], at, source)
                             }
                         }
                     });

@@ -407,6 +407,29 @@ impl<T: Persist + Persistent, const N: usize> Persistent for Array<T, N> {
     }
 }
 
+/// A generated record's fields, one after the other from `at`, each with its image size: one
+/// loop for every record type instead of a call sequence per type.
+#[inline(never)]
+pub fn save_fields(fields: &[(&dyn Persistent, usize)], mut at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+    let mut ok = true;
+    for &(field, size) in fields {
+        ok &= field.save_to(at, sink);
+        at += size;
+    }
+    ok
+}
+
+/// Loads a generated record's fields ([`save_fields`]).
+#[inline(never)]
+pub fn load_fields(fields: &mut [(&mut dyn Persistent, usize)], mut at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+    let mut ok = true;
+    for (field, size) in fields {
+        ok &= field.load_from(at, source);
+        at += *size;
+    }
+    ok
+}
+
 #[cfg(test)]
 mod persist_tests {
     use super::*;
