@@ -31,3 +31,16 @@ impl embedded_hal::delay::DelayNs for MsDelay {
         MsDelay::wait_ms(ms);
     }
 }
+
+/// Every image's first step: the core clock at [`CORE_HZ`] (the 8 MHz crystal x 6, or the
+/// HSI48 with the `hsi48` feature), then the SysTick millisecond clock.
+pub fn start_core(rcc: stm32f0xx_hal::pac::RCC, flash: &mut stm32f0xx_hal::pac::FLASH, syst: cortex_m::peripheral::SYST) -> stm32f0xx_hal::rcc::Rcc {
+    use stm32f0xx_hal::prelude::*;
+    #[cfg(not(feature = "hsi48"))]
+    let cfgr = rcc.configure().hse(8.mhz(), stm32f0xx_hal::rcc::HSEBypassMode::NotBypassed);
+    #[cfg(feature = "hsi48")]
+    let cfgr = rcc.configure().hsi48();
+    let rcc = cfgr.sysclk(48.mhz()).pclk(48.mhz()).freeze(flash);
+    start(syst);
+    rcc
+}

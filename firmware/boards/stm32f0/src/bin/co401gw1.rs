@@ -49,12 +49,7 @@ fn main() -> ! {
     static mut CHIP: MaybeUninit<Chip> = MaybeUninit::uninit();
     let (Some(core), Some(mut p)) = (cortex_m::Peripherals::take(), pac::Peripherals::take()) else { panic!("peripherals taken twice") };
 
-    #[cfg(not(feature = "hsi48"))]
-    let cfgr = p.RCC.configure().hse(8.mhz(), stm32f0xx_hal::rcc::HSEBypassMode::NotBypassed);
-    #[cfg(feature = "hsi48")]
-    let cfgr = p.RCC.configure().hsi48();
-    let mut rcc = cfgr.sysclk(48.mhz()).pclk(48.mhz()).freeze(&mut p.FLASH);
-    clock::start(core.SYST);
+    let mut rcc = clock::start_core(p.RCC, &mut p.FLASH, core.SYST);
 
     let gpioa = p.GPIOA.split(&mut rcc);
     let gpiob = p.GPIOB.split(&mut rcc);
