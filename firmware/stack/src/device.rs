@@ -49,13 +49,6 @@ pub trait Device {
     fn host_port(&mut self) -> Option<&mut dyn HostPort> {
         None
     }
-
-    /// Whether the CAN controller takes part in the bus: `false` while the device keeps its
-    /// CAN side off (CO401GW1 until its host enables CAN), when a board keeps the controller
-    /// off the bus, so that it neither acknowledges nor disturbs frames.
-    fn can_active(&self) -> bool {
-        true
-    }
 }
 
 /// A device's serial host interface, as a byte stream each way.

@@ -55,8 +55,8 @@ impl Indicators for OwnIndicators {
 
 /// Starts the device and serves it for ever. `bxcan` comes disabled (off the bus) with its
 /// bit timing and filters set: it is enabled once the device's CAN side is
-/// active ([`Device::can_active`]: at once for most devices, after the host's enable command
-/// for CO401GW1). Not inlined: the device's handlers inlined here have frames of their own,
+/// active (`NodeAccess::can_enabled`: at once for most devices, after the host's enable
+/// command for CO401GW1). Not inlined: the device's handlers inlined here have frames of their own,
 /// which must not add to the frame that built the device.
 #[inline(never)]
 pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut indicators: impl Indicators) -> ! {
@@ -87,7 +87,7 @@ pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut indi
             }
         }
 
-        if !on_bus && device.can_active() {
+        if !on_bus && device.node().can_enabled() {
             // Joins the bus once it sees 11 recessive bits, in the background: a bus held
             // dominant must not stop the serial host. ABOM (set by `enable_non_blocking`)
             // restarts after bus-off by itself.

@@ -605,11 +605,6 @@ impl<B: Board, S: ParamStore> Device for Gw1<B, S> {
     fn host_port(&mut self) -> Option<&mut dyn HostPort> {
         Some(self)
     }
-
-    /// Off the bus until the host enables CAN (`02 00`/`02 81`).
-    fn can_active(&self) -> bool {
-        self.node.can_enabled()
-    }
 }
 
 /// The UART: one telegram in, at most one answer out; refused telegrams get none.
