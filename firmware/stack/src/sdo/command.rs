@@ -278,6 +278,75 @@ pub(super) fn block_upload_end_frame(n: u8, crc: u16) -> [u8; 8] {
     with_bytes(SCS_BLOCK_UPLOAD | (n & 0x07) << 2 | SS_END, [c0, c1, 0, 0, 0, 0, 0])
 }
 
+// The client side: what a client sends (built by the `*_request` functions) and what it
+// reads from the server, decoded into a [`Response`].
+
+/// A server response, decoded from its command byte alone (the client's state decides
+/// whether it fits).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Response {
+    /// scs = 2: expedited (the data in `data`, `4 - n` bytes if sized) or segmented (the size
+    /// in `data` if sized).
+    UploadInitiate { mux: Mux, expedited: bool, sized: bool, n: u8, data: [u8; 4] },
+    /// scs = 0.
+    UploadSegment(Segment),
+    /// scs = 3.
+    DownloadInitiate { mux: Mux },
+    /// scs = 1.
+    DownloadSegment { toggle: bool },
+    /// scs = 4: the server's code, unchanged (it may be one CiA 301 does not list).
+    Abort { mux: Mux, code: u32 },
+    /// scs = 5, 6 or 7: block transfer responses and undefined specifiers, which no
+    /// expedited or segmented transfer expects.
+    Other,
+}
+
+impl Response {
+    pub(super) fn parse(frame: &[u8; 8]) -> Response {
+        let [b0, i0, i1, sub, d0, d1, d2, d3] = *frame;
+        let mux = Mux { index: u16::from_le_bytes([i0, i1]), sub };
+        let data = [d0, d1, d2, d3];
+        match b0 & 0xE0 {
+            SCS_UPLOAD_SEGMENT => {
+                Response::UploadSegment(Segment { toggle: b0 & TOGGLE != 0, n: (b0 >> 1) & 0x07, last: b0 & LAST != 0, data: [i0, i1, sub, d0, d1, d2, d3] })
+            }
+            SCS_DOWNLOAD_SEGMENT => Response::DownloadSegment { toggle: b0 & TOGGLE != 0 },
+            SCS_INITIATE_UPLOAD => Response::UploadInitiate { mux, expedited: b0 & EXPEDITED != 0, sized: b0 & SIZED != 0, n: (b0 >> 2) & 0x03, data },
+            SCS_INITIATE_DOWNLOAD => Response::DownloadInitiate { mux },
+            ABORT => Response::Abort { mux, code: u32::from_le_bytes(data) },
+            _ => Response::Other,
+        }
+    }
+}
+
+/// Initiate upload request.
+pub(super) fn upload_initiate_request(mux: Mux) -> [u8; 8] {
+    with_mux(CCS_INITIATE_UPLOAD << 5, mux, [0; 4])
+}
+
+/// Upload segment request.
+pub(super) fn upload_segment_request(toggle: bool) -> [u8; 8] {
+    with_bytes(CCS_UPLOAD_SEGMENT << 5 | if toggle { TOGGLE } else { 0 }, [0; 7])
+}
+
+/// Expedited initiate download request with size indicated; `data` holds 1..=4 bytes.
+pub(super) fn download_expedited_request(mux: Mux, data: &[u8]) -> [u8; 8] {
+    let mut bytes = [0; 4];
+    bytes.iter_mut().zip(data).for_each(|(dst, src)| *dst = *src);
+    let n = 4_usize.saturating_sub(data.len()).min(3) as u8;
+    with_mux(CCS_INITIATE_DOWNLOAD << 5 | n << 2 | EXPEDITED | SIZED, mux, bytes)
+}
+
+/// Segmented initiate download request with the size indicated.
+pub(super) fn download_initiate_request(mux: Mux, size: u32) -> [u8; 8] {
+    with_mux(CCS_INITIATE_DOWNLOAD << 5 | SIZED, mux, size.to_le_bytes())
+}
+
+/// Download segment request: the same layout as the server's upload segment (ccs = scs = 0).
+pub(super) fn download_segment_request(toggle: bool, data: [u8; 7], len: usize, last: bool) -> [u8; 8] {
+    upload_segment_frame(toggle, data, len, last)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -310,6 +379,35 @@ mod tests {
         assert_eq!(Request::parse(&[0xD5, 0xC3, 0x31, 0, 0, 0, 0, 0]), Request::BlockDownloadEnd { n: 5, crc: 0x31C3 });
         assert_eq!(Request::parse(&[0xE0, 0x18, 0x10, 0x02, 0, 0, 0, 0]), Request::Unknown { mux: MUX });
         assert_eq!(BlockSegment::parse(&[0x85, 1, 2, 3, 4, 5, 6, 7]), BlockSegment { seq: 5, last: true, data: [1, 2, 3, 4, 5, 6, 7] });
+    }
+
+    #[test]
+    fn client_requests_encode_and_server_responses_decode() {
+        assert_eq!(upload_initiate_request(MUX), [0x40, 0x18, 0x10, 0x02, 0, 0, 0, 0]);
+        assert_eq!(upload_segment_request(true), [0x70, 0, 0, 0, 0, 0, 0, 0]);
+        assert_eq!(upload_segment_request(false), [0x60, 0, 0, 0, 0, 0, 0, 0]);
+        assert_eq!(download_expedited_request(MUX, &[0x34, 0x12]), [0x2B, 0x18, 0x10, 0x02, 0x34, 0x12, 0, 0]);
+        assert_eq!(download_expedited_request(MUX, &[1, 2, 3, 4]), [0x23, 0x18, 0x10, 0x02, 1, 2, 3, 4]);
+        assert_eq!(download_initiate_request(MUX, 300), [0x21, 0x18, 0x10, 0x02, 0x2C, 0x01, 0, 0]);
+        assert_eq!(download_segment_request(true, [5; 7], 3, true), [0x19, 5, 5, 5, 5, 5, 5, 5]);
+        // What the client sends is what the server reads, and the other way round.
+        assert_eq!(Request::parse(&download_expedited_request(MUX, &[0x34, 0x12])), Request::parse(&[0x2B, 0x18, 0x10, 0x02, 0x34, 0x12, 0, 0]));
+        assert_eq!(Request::parse(&upload_segment_request(true)), Request::UploadSegment { toggle: true });
+        assert_eq!(
+            Response::parse(&upload_expedited_frame(MUX, &[0xAA])),
+            Response::UploadInitiate { mux: MUX, expedited: true, sized: true, n: 3, data: [0xAA, 0, 0, 0] }
+        );
+        assert_eq!(
+            Response::parse(&upload_initiate_frame(MUX, 300)),
+            Response::UploadInitiate { mux: MUX, expedited: false, sized: true, n: 0, data: [0x2C, 0x01, 0, 0] }
+        );
+        let segment = Response::parse(&upload_segment_frame(true, [9, 8, 0, 0, 0, 0, 0], 2, true));
+        assert_eq!(segment, Response::UploadSegment(Segment { toggle: true, n: 5, last: true, data: [9, 8, 0, 0, 0, 0, 0] }));
+        assert_eq!(Response::parse(&download_initiate_frame(MUX)), Response::DownloadInitiate { mux: MUX });
+        assert_eq!(Response::parse(&download_segment_frame(true)), Response::DownloadSegment { toggle: true });
+        assert_eq!(Response::parse(&abort_frame(MUX, SdoAbort::ToggleBit)), Response::Abort { mux: MUX, code: 0x0503_0000 });
+        assert_eq!(Response::parse(&[0xAB, 0x18, 0x10, 0x02, 0, 0, 0, 0]), Response::Other);
+        assert_eq!(Response::parse(&block_download_ack_frame(1, 2)), Response::Other);
     }
 
     #[test]

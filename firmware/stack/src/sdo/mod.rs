@@ -61,6 +61,7 @@
 //!   block upload sub-block it is not waiting, so each segment sent restarts the clock.
 
 mod block;
+pub mod client;
 mod command;
 mod segmented;
 
