@@ -39,7 +39,7 @@ impl<const N: usize> Link<N> {
                 assert_eq!(request.dlc, 8, "client requests are 8 bytes");
                 self.requests.push(request.data);
                 if let Some(response) = self.server.on_request(&request.data, self.now, &mut self.dict) {
-                    let frame = CanFrame::data(response_id(NODE), &response).unwrap();
+                    let frame = CanFrame::data(response_id(NODE), &response).expect("a valid frame");
                     if let Some(frame) = edit(responses, frame) {
                         next = self.client.on_frame(&frame, self.now, buf);
                     }
@@ -64,12 +64,12 @@ impl<const N: usize> Link<N> {
     }
 
     fn upload(&mut self, index: u16, buf: &mut [u8]) -> SdoResult {
-        let first = self.client.upload(NODE, index, 0, self.now).unwrap();
+        let first = self.client.upload(NODE, index, 0, self.now).expect("an idle client");
         self.run(first, buf, |_, f| Some(f))
     }
 
     fn download(&mut self, index: u16, data: &[u8]) -> SdoResult {
-        let first = self.client.download(NODE, index, 0, data, self.now).unwrap();
+        let first = self.client.download(NODE, index, 0, data, self.now).expect("an idle client");
         self.run(first, &mut data.to_vec(), |_, f| Some(f))
     }
 }
@@ -128,15 +128,15 @@ fn server_aborts_arrive_unchanged_and_change_nothing() {
     let mut buf = [0; 8];
     assert_eq!(link.client.upload(NODE, U32, 1, 0).map(|_| ()), Ok(()));
     link.client.cancel();
-    let first = link.client.upload(NODE, U32, 1, 0).unwrap();
+    let first = link.client.upload(NODE, U32, 1, 0).expect("an idle client");
     assert_eq!(link.run(first, &mut buf, |_, f| Some(f)), aborted(SdoAbort::NoSubIndex, AbortSource::Server));
     assert_eq!(link.dict.writes, 0);
     // A code CiA 301 does not list is reported as sent.
     let mut client = SdoClient::new();
-    client.upload(NODE, 0x2000, 0, 0).unwrap();
-    let abort = CanFrame::data(response_id(NODE), &[0x80, 0x00, 0x20, 0x00, 0x78, 0x56, 0x34, 0x12]).unwrap();
+    client.upload(NODE, 0x2000, 0, 0).expect("an idle client");
+    let abort = CanFrame::data(response_id(NODE), &[0x80, 0x00, 0x20, 0x00, 0x78, 0x56, 0x34, 0x12]).expect("a valid frame");
     assert_eq!(client.on_frame(&abort, 0, &mut buf), None, "nothing answers an abort");
-    let result = client.take_result().unwrap();
+    let result = client.take_result().expect("a result");
     assert_eq!(result, SdoResult::Aborted { code: 0x1234_5678, by: AbortSource::Server });
     assert_eq!(result.abort(), None);
 }
@@ -147,7 +147,7 @@ fn an_upload_larger_than_the_buffer_aborts_and_the_server_hears_it() {
     let mut small = [0; 50];
     assert_eq!(link.upload(DOMAIN, &mut small), aborted(SdoAbort::OutOfMemory, AbortSource::Client));
     assert!(link.server.is_idle(), "the abort reached the server");
-    assert_eq!(link.requests.last().unwrap()[0], 0x80);
+    assert_eq!(link.requests.last().expect("a request")[0], 0x80);
     // Expedited: the server has finished, so only the caller learns of it.
     let mut tiny = [0; 2];
     link.requests.clear();
@@ -158,7 +158,7 @@ fn an_upload_larger_than_the_buffer_aborts_and_the_server_hears_it() {
 #[test]
 fn one_transfer_per_channel() {
     let mut client = SdoClient::new();
-    client.upload(NODE, U32, 0, 0).unwrap();
+    client.upload(NODE, U32, 0, 0).expect("an idle client");
     assert_eq!(client.server(), Some(NODE));
     assert_eq!(client.upload(6, U32, 0, 0), Err(StartError::Busy));
     assert_eq!(client.download(NODE, U32, 0, &[1], 0), Err(StartError::Busy));
@@ -338,16 +338,16 @@ fn malformed_or_missing_answers() {
         let before = link.dict.clone();
         let mut buf = [0_u8; 256];
         let first = if case.upload {
-            link.client.upload(NODE, case.index, 0, 0).unwrap()
+            link.client.upload(NODE, case.index, 0, 0).expect("an idle client")
         } else {
             buf[..200].fill(0xEE);
-            link.client.download(NODE, case.index, 0, if case.index == U32 { &buf[..4] } else { &buf[..200] }, 0).unwrap()
+            link.client.download(NODE, case.index, 0, if case.index == U32 { &buf[..4] } else { &buf[..200] }, 0).expect("an idle client")
         };
         let result = link.run(first, &mut buf, |i, f| if i == case.at { (case.edit)(f) } else { Some(f) });
         assert_eq!(result, case.result, "{}", case.name);
-        assert_eq!(link.requests.last().unwrap()[0] == 0x80, case.abort_sent, "{}: abort frame sent", case.name);
+        assert_eq!(link.requests.last().expect("a request")[0] == 0x80, case.abort_sent, "{}: abort frame sent", case.name);
         if case.abort_sent {
-            let code = u32::from_le_bytes(link.requests.last().unwrap()[4..].try_into().unwrap());
+            let code = u32::from_le_bytes(link.requests.last().expect("a request")[4..].try_into().expect("4 bytes"));
             assert_eq!(SdoResult::Aborted { code, by: AbortSource::Client }, case.result, "{}: the code sent", case.name);
         }
         assert!(link.server.is_idle() || !case.abort_sent, "{}: the server heard the abort", case.name);
@@ -395,20 +395,20 @@ fn arbitrary_frames_never_panic_and_complete_only_on_a_valid_answer() {
     let mut now = 0;
     for _ in 0..200_000 {
         if client.is_idle() {
-            upload = rng.next() % 2 == 0;
+            upload = rng.next().is_multiple_of(2);
             let len = (rng.next() % 21) as usize;
             let started = if upload { client.upload(NODE, 0x2000, 0, now) } else { client.download(NODE, 0x2000, 0, &value[..len], now) };
             assert!(started.is_ok());
         }
         let r = rng.next();
         // Mostly on the response COB-ID, with the object's multiplexer half the time.
-        let id = if r % 16 == 0 { (r >> 8) as u16 & 0x7FF } else { response_id(NODE) };
+        let id = if r.is_multiple_of(16) { (r >> 8) as u16 & 0x7FF } else { response_id(NODE) };
         let mut data = rng.next().to_le_bytes();
         if r & 0x10 != 0 {
             data[1..4].copy_from_slice(&[0x00, 0x20, 0x00]);
         }
         let len = if r & 0x60 == 0 { (r >> 16) as usize % 9 } else { 8 };
-        let frame = if r & 0x380 == 0 { CanFrame::remote(id, 8).unwrap() } else { CanFrame::data(id, &data[..len]).unwrap() };
+        let frame = if r & 0x380 == 0 { CanFrame::remote(id, 8).expect("a valid frame") } else { CanFrame::data(id, &data[..len]).expect("a valid frame") };
         now += 1000;
         let mut buf = [0_u8; 64];
         buf[..20].copy_from_slice(&value);
