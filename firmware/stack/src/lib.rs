@@ -24,6 +24,7 @@ pub mod frame;
 pub mod guarding;
 pub mod heartbeat;
 pub mod leds;
+pub mod manager;
 pub mod nmt;
 pub mod node;
 pub mod od;
