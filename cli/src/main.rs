@@ -1,5 +1,8 @@
-//! `coforge`: check specs, export EDS files and docs, keep spec files canonically formatted.
+//! `coforge`: check specs, export EDS files and docs, keep spec files canonically formatted,
+//! simulate devices and talk to a bus.
 #![forbid(unsafe_code)]
+
+mod master;
 
 use clap::{Parser, Subcommand};
 use coforge_spec::model::Direction;
@@ -112,6 +115,18 @@ enum Cmd {
         /// Stop after this many seconds (default: run until killed).
         #[arg(long)]
         seconds: Option<u64>,
+    },
+    /// Talk to a CANopen bus through a bus hub (`coforge sim`, `coforge hub`): scan the nodes,
+    /// read and write their dictionaries, send NMT commands, watch heartbeats and emergencies.
+    Master {
+        /// The hub's TCP port on this machine, or HOST:PORT (what `coforge sim` printed).
+        #[arg(long)]
+        port: String,
+        /// How long to wait for each SDO answer.
+        #[arg(long, default_value_t = 1000)]
+        timeout_ms: u64,
+        #[command(subcommand)]
+        cmd: master::MasterCmd,
     },
     /// Rewrite specs in canonical formatting, or with --check report files that differ.
     Fmt {
@@ -286,6 +301,7 @@ fn hub(port: u16, adapters: &[String], seconds: Option<u64>) -> Result<ExitCode,
 fn run(cmd: Cmd) -> Result<ExitCode, String> {
     match cmd {
         Cmd::Hub { port, connect, seconds } => hub(port, &connect, seconds),
+        Cmd::Master { port, timeout_ms, cmd } => master::run(&port, timeout_ms, cmd),
         Cmd::Sim { device, node_id, port, mode, store, nodes, seconds, serial, enable_can } => {
             sim(SimArgs { device: &device, first_id: node_id, port, mode: mode.as_deref(), store, count: nodes, seconds, serial, enable_can })
         }

@@ -80,6 +80,43 @@ impl SdoAbort {
     pub fn from_code(code: u32) -> Option<SdoAbort> {
         SdoAbort::ALL.into_iter().find(|a| a.code() == code)
     }
+
+    /// The meaning CiA 301 (table 22) gives the code, for people reading an abort.
+    pub const fn description(self) -> &'static str {
+        match self {
+            SdoAbort::ToggleBit => "toggle bit not alternated",
+            SdoAbort::Timeout => "SDO protocol timed out",
+            SdoAbort::UnknownCommand => "client/server command specifier not valid or unknown",
+            SdoAbort::InvalidBlockSize => "invalid block size (block mode only)",
+            SdoAbort::InvalidSequence => "invalid sequence number (block mode only)",
+            SdoAbort::BlockCrc => "CRC error (block mode only)",
+            SdoAbort::OutOfMemory => "out of memory",
+            SdoAbort::UnsupportedAccess => "unsupported access to an object",
+            SdoAbort::WriteOnly => "attempt to read a write only object",
+            SdoAbort::ReadOnly => "attempt to write a read only object",
+            SdoAbort::NoObject => "object does not exist in the object dictionary",
+            SdoAbort::NotMappable => "object cannot be mapped to the PDO",
+            SdoAbort::PdoTooLong => "the number and length of the objects to be mapped would exceed the PDO length",
+            SdoAbort::IncompatibleParameter => "general parameter incompatibility reason",
+            SdoAbort::IncompatibleInternal => "general internal incompatibility in the device",
+            SdoAbort::Hardware => "access failed due to a hardware error",
+            SdoAbort::LengthMismatch => "data type does not match, length of service parameter does not match",
+            SdoAbort::LengthTooHigh => "data type does not match, length of service parameter too high",
+            SdoAbort::LengthTooLow => "data type does not match, length of service parameter too low",
+            SdoAbort::NoSubIndex => "sub-index does not exist",
+            SdoAbort::InvalidValue => "invalid value for parameter (download only)",
+            SdoAbort::ValueTooHigh => "value of parameter written too high (download only)",
+            SdoAbort::ValueTooLow => "value of parameter written too low (download only)",
+            SdoAbort::MaxBelowMin => "maximum value is less than minimum value",
+            SdoAbort::NoResource => "resource not available: SDO connection",
+            SdoAbort::General => "general error",
+            SdoAbort::DataTransfer => "data cannot be transferred or stored to the application",
+            SdoAbort::DataTransferLocal => "data cannot be transferred or stored to the application because of local control",
+            SdoAbort::DataTransferState => "data cannot be transferred or stored to the application because of the present device state",
+            SdoAbort::NoDictionary => "object dictionary dynamic generation fails or no object dictionary is present",
+            SdoAbort::NoData => "no data available",
+        }
+    }
 }
 
 #[cfg(test)]
@@ -105,5 +142,10 @@ mod tests {
             assert_eq!(SdoAbort::from_code(a.code()), Some(a));
         }
         assert_eq!(SdoAbort::from_code(0x1234_5678), None);
+        assert_eq!(SdoAbort::NoObject.description(), "object does not exist in the object dictionary");
+        // Every code has its own text.
+        for (i, a) in SdoAbort::ALL.iter().enumerate() {
+            assert!(SdoAbort::ALL[..i].iter().all(|b| b.description() != a.description()), "{a:?}");
+        }
     }
 }
