@@ -308,14 +308,15 @@ fn human_time(ns: f64) -> String {
     }
 }
 
-/// `cargo xtask bench [--selftest | --instructions]`: the whole report, only the self-test, or
-/// only the instruction counts.
+/// `cargo xtask bench [--selftest | --instructions | --callgrind]`: the whole report, only the
+/// self-test, only the Cortex-M3 instruction counts, or only the x86-64 manager figure.
 pub fn main(args: &[String]) -> Result {
     match args {
         [] => report(),
         [flag] if flag == "--selftest" => selftest().map(|_| ()),
         [flag] if flag == "--instructions" => instructions().map(|table| println!("{table}")),
-        _ => Err("usage: cargo xtask bench [--selftest | --instructions]".into()),
+        [flag] if flag == "--callgrind" => callgrind_manager_upload().map(|n| println!("manager expedited SDO upload on x86-64: {n} instructions")),
+        _ => Err("usage: cargo xtask bench [--selftest | --instructions | --callgrind]".into()),
     }
 }
 
@@ -344,9 +345,41 @@ fn instructions() -> Result<String> {
     Ok(md)
 }
 
+/// Uploads `firmware/stack/examples/manager_upload.rs` runs (its `UPLOADS`).
+const MANAGER_UPLOADS: u64 = 1000;
+
+/// x86-64 instructions per expedited SDO upload through the manager (request queued to
+/// result taken), counted by callgrind with collection on only inside `upload_once`.
+fn callgrind_manager_upload() -> Result<u64> {
+    setup::valgrind()?;
+    run(cargo().args(["build", "--quiet", "--release", "-p", "coforge-stack", "--example", "manager_upload"]).current_dir(root()))?;
+    let out = out_dir().join("callgrind.manager_upload");
+    std::fs::create_dir_all(out_dir()).map_err(|e| format!("cannot create {}: {e}", out_dir().display()))?;
+    let result = Command::new("valgrind")
+        .args(["--tool=callgrind", "--toggle-collect=manager_upload::upload_once"])
+        .arg(format!("--callgrind-out-file={}", out.display()))
+        .arg(root().join("target/release/examples/manager_upload"))
+        .output()
+        .map_err(|e| format!("cannot run valgrind: {e}"))?;
+    if !result.status.success() {
+        return Err(format!("valgrind failed: {}", String::from_utf8_lossy(&result.stderr)));
+    }
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    let refs = stderr
+        .lines()
+        .find_map(|l| l.split_once("I   refs:").map(|(_, n)| n.trim().replace(',', "")))
+        .and_then(|n| n.parse::<u64>().ok())
+        .ok_or_else(|| format!("callgrind printed no instruction total:\n{stderr}"))?;
+    Ok(refs / MANAGER_UPLOADS)
+}
+
 /// Instruction counts, criterion figures and the size report into `target/bench/report.md`.
 pub fn report() -> Result {
-    let table = instructions()?;
+    let mut table = instructions()?;
+    let per_upload = callgrind_manager_upload()?;
+    table.push_str(&format!(
+        "## coforge-stack manager on x86-64 (callgrind)\n\n`firmware/stack/examples/manager_upload.rs`, release: {per_upload} instructions per expedited SDO upload, request queued to result taken ({MANAGER_UPLOADS} uploads, collection only inside `upload_once`).\n\n"
+    ));
 
     println!("xtask: criterion benchmarks ({})", CRITERION_ARGS.join(" "));
     let estimates = criterion()?;

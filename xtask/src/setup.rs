@@ -57,6 +57,14 @@ fn apt_install(packages: &[&str], why: &str) -> Result {
     run(&mut install)
 }
 
+/// valgrind, whose callgrind counts the x86-64 instructions of the manager benchmark.
+pub fn valgrind() -> Result {
+    if output(Command::new("valgrind").arg("--version")).is_none() {
+        apt_install(&["valgrind"], "callgrind counts host instructions for `cargo xtask bench`")?;
+    }
+    Ok(())
+}
+
 /// `qemu-system-arm`, which runs the Cortex-M3 images in the end-to-end tests.
 pub fn qemu() -> Result {
     if output(Command::new("qemu-system-arm").arg("--version")).is_none() {
