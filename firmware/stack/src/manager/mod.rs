@@ -298,6 +298,20 @@ impl<const NODES: usize, const PDOS: usize> Manager<NODES, PDOS> {
 mod tests {
     use super::*;
 
+    #[test]
+    fn nmt_master_frames() {
+        assert_eq!(nmt_frame(NmtCommand::Start, 0), CanFrame::data(0, &[0x01, 0x00]));
+        assert_eq!(nmt_frame(NmtCommand::ResetCommunication, 127), CanFrame::data(0, &[0x82, 0x7F]));
+        assert_eq!(nmt_frame(NmtCommand::Stop, 128), None);
+        let mut m = Manager::<1, 1>::new(ScanConfig::default());
+        assert!(m.nmt(NmtCommand::EnterPreOperational, 5));
+        assert!(!m.nmt(NmtCommand::Start, 200));
+        let mut buf = [0; 4];
+        assert_eq!(m.poll(0, &mut buf), CanFrame::data(0, &[0x80, 0x05]));
+        assert_eq!(m.poll(0, &mut buf), None, "one frame, nothing else happens");
+        assert_eq!(m.take_event(), None);
+    }
+
     /// The RAM figures the README quotes, on a 64-bit host (a Cortex-M build is smaller only
     /// where `usize` fields are: the record cache's length).
     #[test]

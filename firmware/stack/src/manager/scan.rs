@@ -369,3 +369,104 @@ impl<const NODES: usize, const PDOS: usize> Scanner<NODES, PDOS> {
         &self.cache
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CONFIG: ScanConfig = ScanConfig { pdos: 2, heartbeat_ms: Some(100) };
+
+    fn read(n: u32) -> (SdoResult, [u8; 4]) {
+        (SdoResult::Uploaded { len: 4 }, n.to_le_bytes())
+    }
+
+    fn refused() -> (SdoResult, [u8; 4]) {
+        (SdoResult::Aborted { code: 0x0602_0000, by: AbortSource::Server }, [0; 4])
+    }
+
+    /// Answers each transfer the scan asks for with `answer`, until it ends: the transfers
+    /// asked for, in order, and how the scan ended.
+    fn run(scan: &mut NodeScan<2>, mut answer: impl FnMut(ScanTransfer) -> (SdoResult, [u8; 4])) -> (heapless::Vec<ScanTransfer, 64>, Progress) {
+        let mut asked = heapless::Vec::new();
+        while let Some(t) = scan.transfer() {
+            asked.push(t).expect("a bounded scan");
+            let (result, value) = answer(t);
+            match scan.on_result(&result, &value) {
+                Progress::Continue => {}
+                end => return (asked, end),
+            }
+        }
+        (asked, Progress::Continue)
+    }
+
+    #[test]
+    fn what_a_node_lacks_is_recorded_not_fatal() {
+        let mut scan = NodeScan::<2>::new(9, CONFIG);
+        let (asked, end) = run(&mut scan, |t| match t {
+            ScanTransfer::Read { index: 0x1000, .. } => read(0x0003_0191),
+            ScanTransfer::Read { index: 0x1018, sub: 1, .. } => read(0x58),
+            ScanTransfer::Read { index: 0x1018, .. } => refused(),
+            // TPDO1: COB-ID 189h, type 254, three entries of which the third cannot be read.
+            ScanTransfer::Read { index: 0x1800, sub: 1, .. } => read(0x189),
+            ScanTransfer::Read { index: 0x1800, sub: 2, .. } => read(254),
+            ScanTransfer::Read { index: 0x1A00, sub: 0, .. } => read(3),
+            ScanTransfer::Read { index: 0x1A00, sub: 3, .. } => refused(),
+            ScanTransfer::Read { index: 0x1A00, sub, .. } => read(0x6000_0008 | u32::from(sub) << 8),
+            // The other PDOs do not exist.
+            ScanTransfer::Read { .. } => refused(),
+            ScanTransfer::Write { .. } => (SdoResult::Downloaded, [0; 4]),
+        });
+        assert_eq!(end, Progress::Complete);
+        let r = scan.record();
+        assert_eq!((r.node, r.device_type, r.identity), (9, 0x0003_0191, [0x58, 0, 0, 0]));
+        assert_eq!((r.tpdos[0].cob_id, r.tpdos[0].transmission, r.tpdos[0].mapping()), (0x189, 254, &[0x6000_0108, 0x6000_0208][..]));
+        assert!(r.tpdos[0].is_valid());
+        assert!(!r.tpdos[1].is_valid() && !r.rpdos[0].is_valid() && !r.rpdos[1].is_valid());
+        // 1000h, 1018h.1..4, TPDO1 (2 comm + count + 3 entries), TPDO2, RPDO1, RPDO2 (one
+        // refused read each), the 1017h write.
+        assert_eq!(asked.len(), 1 + 4 + 6 + 3 + 1);
+        assert_eq!(asked.last(), Some(&ScanTransfer::Write { node: 9, index: 0x1017, sub: 0, data: [100, 0] }));
+    }
+
+    #[test]
+    fn a_silent_node_or_a_missing_mandatory_object_aborts() {
+        let mut scan = NodeScan::<2>::new(9, CONFIG);
+        let timeout = SdoResult::Aborted { code: 0x0504_0000, by: AbortSource::Client };
+        assert_eq!(scan.on_result(&timeout, &[]), Progress::Aborted(0x0504_0000));
+        assert_eq!(scan.transfer(), None);
+        let mut scan = NodeScan::<2>::new(9, CONFIG);
+        let (_, end) = run(&mut scan, |t| if matches!(t, ScanTransfer::Read { index: 0x1000, .. }) { read(0x191) } else { refused() });
+        assert_eq!(end, Progress::Aborted(0x0602_0000), "1018h.1 is mandatory");
+        // A timeout in the middle ends the scan too.
+        let mut scan = NodeScan::<2>::new(9, ScanConfig { pdos: 0, heartbeat_ms: None });
+        let (asked, end) = run(&mut scan, |t| match t {
+            ScanTransfer::Read { index: 0x1018, sub: 3, .. } => (timeout, [0; 4]),
+            _ => read(1),
+        });
+        assert_eq!((asked.len(), end), (4, Progress::Aborted(0x0504_0000)));
+    }
+
+    #[test]
+    fn the_scanner_queues_caches_and_forgets_the_oldest() {
+        let mut s = Scanner::<2, 2>::new(ScanConfig::default());
+        for n in [7, 3, 5] {
+            s.request(n);
+        }
+        s.request(0);
+        s.request(128);
+        let mut order = heapless::Vec::<u8, 4>::new();
+        while let Some(ScanEvent::Started(n)) = s.start_next() {
+            order.push(n).expect("three scans");
+            assert!(s.knows(n));
+            let mut end = None;
+            while end.is_none() {
+                end = s.on_result(&SdoResult::Uploaded { len: 4 }, &[1, 0, 0, 0]);
+            }
+            assert_eq!(end, Some(ScanEvent::Complete(n)));
+        }
+        assert_eq!(order, [3, 5, 7], "lowest node-ID first; 0 and 128 are no nodes");
+        assert_eq!(s.cached().iter().map(|r| r.node).collect::<heapless::Vec<u8, 2>>(), [5, 7], "node 3 left the full cache");
+        assert!(s.knows(3), "scanned, though no longer cached");
+        assert!(s.scanned(3).is_none() && s.scanned(7).is_some_and(|r| r.device_type == 1));
+    }
+}
