@@ -15,6 +15,7 @@ pub mod banks;
 pub mod framing;
 pub mod gw1;
 pub mod integrity;
+pub mod manager;
 pub mod node;
 pub mod stack;
 
