@@ -399,6 +399,14 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
     pub fn tx_overflows(&self) -> u32 {
         self.core.tx_overflows
     }
+
+    /// Queues any frame from device code (a manager's NMT commands, say) behind the node's
+    /// own: `false` if the transmit queue was full, which counts in [`Node::tx_overflows`].
+    /// Like every node frame it goes out through [`Node::poll`] only while the CAN side is
+    /// enabled and not bus-off, and the boot-up (power-on, NMT reset) empties the queue.
+    pub fn send_frame(&mut self, frame: CanFrame) -> bool {
+        self.core.queue(Some(frame))
+    }
 }
 
 impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {

@@ -433,3 +433,31 @@ fn without_a_remapping_object_mappings_follow_cia_301_alone() {
     assert_eq!(download(&mut n, 0x1800, 1, &(0x8000_0180 + u32::from(ID)).to_le_bytes()), Ok(()));
     assert_eq!(download(&mut n, 0x1A00, 0, &[0]), Ok(()));
 }
+
+#[test]
+fn device_frames_queue_behind_the_nodes_own_and_count_when_lost() {
+    let mut n = node(NodeConfig::new(ID), &[]);
+    let nmt_start = CanFrame::data(0x000, &[0x01, 0]).unwrap();
+    let queued: Vec<bool> = (0..13).map(|i| n.send_frame(CanFrame { data: [i, 0, 0, 0, 0, 0, 0, 0], ..nmt_start })).collect();
+    assert_eq!(queued, [[true; 12].as_slice(), &[false]].concat(), "the queue holds 12 frames");
+    assert_eq!(n.tx_overflows(), 1, "the lost one is counted");
+    let sent = frames(&mut n, 0);
+    assert_eq!(sent.iter().map(|f| f.data[0]).collect::<Vec<u8>>(), (0..12).collect::<Vec<u8>>(), "sent in order, unchanged");
+    assert!(sent.iter().all(|f| f.id == 0 && f.dlc == 2));
+    assert!(n.send_frame(nmt_start), "room again once sent");
+    assert_eq!(frames(&mut n, 0), [nmt_start]);
+}
+
+#[test]
+fn device_frames_wait_for_the_can_side() {
+    let mut n: TestNode = Node::new(TestOd::new((), ID, NoAppObjects), NoStore, NodeConfig::new(ID));
+    n.power_on(0);
+    let frame = CanFrame::data(0x123, &[1, 2, 3]).unwrap();
+    assert!(n.send_frame(frame));
+    assert_eq!(frames(&mut n, 0), [], "nothing goes out before the CAN side is enabled");
+    n.enable_can((), 0);
+    assert_eq!(frames(&mut n, 0), [CanFrame::data(0x700 + u16::from(ID), &[0]).unwrap()], "the boot-up empties the queue");
+    assert!(n.send_frame(frame));
+    n.on_bus_state(BusState::BusOff, 0);
+    assert_eq!(frames(&mut n, 0), [], "a bus-off controller sends nothing");
+}
