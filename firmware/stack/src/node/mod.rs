@@ -9,6 +9,12 @@
 //! All times are microseconds from an arbitrary epoch; the node never reads a clock itself.
 //! Deadlines saturate at `u64::MAX` (584 000 years) rather than overflow.
 //!
+//! Every write that takes effect is indicated to the dictionary's app objects
+//! ([`AppObjects::written`](crate::od::AppObjects::written)): SDO downloads, each entry an
+//! RPDO writes, [`Node::write`] by the host or the device, 1010h/1011h commands that
+//! succeeded. A refused write, or one whose auto-save failed (answered `Hardware`), is not
+//! indicated; nor are [`Node::od_mut`] accesses and the node's own bookkeeping (1001h, 1003h).
+//!
 //! - `target`: writes with their side effects, and the SDO server's view of the node;
 //! - `comm`: the CiA 301 rules for writes to communication objects (PDO remapping and more);
 //! - `process_data`: RPDOs and TPDOs at run time;
@@ -29,7 +35,7 @@ use crate::guarding::{GuardEvent, Guarding};
 use crate::heartbeat::{Consumer, ConsumerEvent, Producer};
 use crate::leds::Leds;
 use crate::nmt::{self, NmtCommand, NmtState};
-use crate::od::{AccessContext, Area, EntryAccess, NodeDictionary, SdoAbort, Side};
+use crate::od::{AccessContext, Area, EntryAccess, NodeDictionary, SdoAbort, Side, WriteSource};
 use crate::pdo::mapping::Mapping;
 use crate::pdo::slot::NEVER;
 use crate::pdo::{Dir, Rpdo, Tpdo};
@@ -310,9 +316,9 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
 
     /// A write by the device itself or its serial host, with the same side effects as an SDO
     /// download: communication-object checks, event-driven TPDOs (with `tpdo_on_write`),
-    /// auto-save.
+    /// auto-save, and the write indication (a `Side::Bus` write is indicated as an SDO one).
     pub fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
-        self.core.write(index, sub, data, side)
+        self.core.write(index, sub, data, WriteSource::of_side(side))
     }
 
     /// A read on behalf of `side`.

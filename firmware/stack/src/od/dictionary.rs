@@ -1,7 +1,7 @@
 //! The traits generated dictionaries implement: entry access (`EntryAccess`), what a node
 //! needs beyond it (`NodeDictionary`), and the owner of app-backed objects (`AppObjects`).
 
-use super::{AccessContext, EntryInfo, Limits, ReadLen, SdoAbort, Side, find};
+use super::{AccessContext, EntryInfo, Limits, ReadLen, SdoAbort, Side, WriteSource, find};
 use crate::value::OdValue;
 use coforge_types::Storage;
 
@@ -193,9 +193,20 @@ pub fn mode_named<D: NodeDictionary>(name: Option<&str>) -> Result<D::Mode, &'st
 /// the generated dictionary routes their reads and writes here, after its access checks.
 /// `entry` may describe a run of sub-indices and of repeated objects; `index`/`sub` is the one
 /// accessed.
+///
+/// The owner of the objects also hears about writes (CANopenNode's OD extension idea): the
+/// provided hooks do nothing and inline to nothing, so a device that does not override them
+/// carries no code for them.
 pub trait AppObjects {
     fn read(&mut self, entry: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
     fn write(&mut self, entry: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
+
+    /// A write of the local entry `index`/`sub` took effect, any entry (not only app-backed
+    /// ones): `data` as written, `by` whoever wrote it. The node calls it once per successful
+    /// write, after the write's side effects (TPDO triggers, reloaded services, auto-save),
+    /// and never for a refused or failed one; see [`crate::node::Node`] for which writes
+    /// count.
+    fn written(&mut self, _index: u16, _sub: u8, _data: &[u8], _by: WriteSource) {}
 }
 
 /// For devices without app-backed objects: nothing is routed here.
