@@ -318,7 +318,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
     /// download: communication-object checks, event-driven TPDOs (with `tpdo_on_write`),
     /// auto-save, and the write indication (a `Side::Bus` write is indicated as an SDO one).
     pub fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
-        self.core.write(index, sub, data, WriteSource::of_side(side))
+        self.core.write_indicated(index, sub, data, WriteSource::of_side(side))
     }
 
     /// A read on behalf of `side`.

@@ -7,18 +7,19 @@ use crate::sdo::SdoTarget;
 use crate::store::ParamStore;
 
 impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
-    /// A write from any side, told to the app objects once it took effect: the one place
-    /// SDO, host and device writes are indicated (RPDOs write entries directly, see
-    /// `apply_rpdo`).
-    pub(super) fn write(&mut self, index: u16, sub: u8, data: &[u8], by: WriteSource) -> Result<(), SdoAbort> {
-        self.apply_write(index, sub, data, by.side())?;
+    /// A write, then its indication if it took effect: the one place SDO, host and device
+    /// writes are indicated (RPDOs write entries directly, see `apply_rpdo`). Inlined, so
+    /// with the indication empty each caller is left with the plain `write` call.
+    #[inline(always)]
+    pub(super) fn write_indicated(&mut self, index: u16, sub: u8, data: &[u8], by: WriteSource) -> Result<(), SdoAbort> {
+        self.write(index, sub, data, by.side())?;
         self.od.app().written(index, sub, data, by);
         Ok(())
     }
 
-    /// The communication-object rules first, then the dictionary's own checks, then
-    /// whatever the new value changes.
-    fn apply_write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
+    /// A write from any side: the communication-object rules first, then the dictionary's
+    /// own checks, then whatever the new value changes.
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
         let ctx = self.ctx();
         let entry = self.od.entry(index, sub)?;
         if matches!(index, 0x1010 | 0x1011) && sub >= 1 {
@@ -124,7 +125,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, 
     }
 
     fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
-        Core::write(self, index, sub, data, WriteSource::Sdo)
+        self.write_indicated(index, sub, data, WriteSource::Sdo)
     }
 
     fn fixed_size(&mut self, index: u16, sub: u8) -> Option<usize> {

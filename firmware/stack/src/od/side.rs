@@ -20,12 +20,12 @@ pub enum Side {
 pub enum WriteSource {
     /// An SDO download (expedited, segmented or block).
     Sdo,
-    /// A received PDO, one write per mapped entry.
-    Rpdo,
     /// The serial host.
     Host,
     /// The device's own code.
     Device,
+    /// A received PDO, one write per mapped entry.
+    Rpdo,
 }
 
 impl WriteSource {
