@@ -253,7 +253,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
             self.core.event(NodeEvent::NmtReceived(cs));
             if let Some(cmd) = NmtCommand::from_code(cs) {
                 if matches!(cmd, NmtCommand::ResetNode | NmtCommand::ResetCommunication | NmtCommand::Stop) {
-                    self.sdo.reset();
+                    self.sdo.reset(&mut self.core);
                 }
                 self.core.nmt_command(cmd, now_us);
             }

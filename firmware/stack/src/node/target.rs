@@ -132,6 +132,39 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, 
         let e = self.od.entry(index, sub).ok()?;
         e.data_type().bits().map(|_| usize::from(e.size))
     }
+
+    const STREAMING: bool = <D::App as AppObjects>::STREAMING;
+
+    fn streams(&mut self, index: u16, sub: u8) -> bool {
+        match self.od.entry(index, sub) {
+            Ok(entry) if entry.storage() == Storage::App => self.od.app().streams(entry, index, sub),
+            _ => false,
+        }
+    }
+
+    /// Checked again for every part, as a whole write would be at its end: the NMT state may
+    /// have changed since the initiation, and without an indicated size only the parts show
+    /// the length. The completed download has a whole write's side effects and indication.
+    fn write_part(&mut self, index: u16, sub: u8, offset: usize, data: &[u8], last: bool) -> Result<(), SdoAbort> {
+        let ctx = self.ctx();
+        let entry = self.od.entry(index, sub)?;
+        entry.check_write_access(Side::Bus, &ctx)?;
+        if offset.saturating_add(data.len()) > usize::from(entry.size) {
+            return Err(SdoAbort::LengthTooHigh);
+        }
+        self.od.app().write_part(entry, index, sub, offset, data, last)?;
+        if last {
+            self.after_write(index, sub);
+            self.od.app().written(index, sub, &[], WriteSource::Sdo);
+        }
+        Ok(())
+    }
+
+    fn abort_stream(&mut self, index: u16, sub: u8) {
+        if let Ok(entry) = self.od.entry(index, sub) {
+            self.od.app().abort_stream(entry, index, sub);
+        }
+    }
 }
 
 impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {

@@ -90,13 +90,19 @@ static ENTRIES: [EntryInfo; ENTRY_COUNT] = {
     out
 };
 
-/// The owner of 1F50h.2: keeps what is written to it and logs every write indication.
+/// The owner of 1F50h.2: keeps what is written to it (streamed while `streaming` is set) and
+/// logs every write indication.
 #[derive(Debug, Default)]
 pub(super) struct Recorder {
     /// Every indication, in order: index, sub-index, data, source.
     written: Vec<(u16, u8, Vec<u8>, WriteSource)>,
     /// 1F50h.2's value.
     program: Vec<u8>,
+    streaming: bool,
+    /// The parts of a streamed download so far.
+    incoming: Vec<u8>,
+    /// Streamed downloads that ended without success.
+    aborted: usize,
 }
 
 impl AppObjects for Recorder {
@@ -111,6 +117,27 @@ impl AppObjects for Recorder {
 
     fn written(&mut self, index: u16, sub: u8, data: &[u8], by: WriteSource) {
         self.written.push((index, sub, data.to_vec(), by));
+    }
+
+    const STREAMING: bool = true;
+
+    fn streams(&mut self, entry: &EntryInfo, index: u16, sub: u8) -> bool {
+        assert_eq!((entry.index, index, sub), (0x1F50, 0x1F50, 2), "asked for app-backed entries only");
+        self.streaming
+    }
+
+    fn write_part(&mut self, _: &EntryInfo, _: u16, _: u8, offset: usize, data: &[u8], last: bool) -> Result<(), SdoAbort> {
+        assert_eq!(offset, self.incoming.len(), "in order, without gaps");
+        self.incoming.extend_from_slice(data);
+        if last {
+            self.program = core::mem::take(&mut self.incoming);
+        }
+        Ok(())
+    }
+
+    fn abort_stream(&mut self, _: &EntryInfo, _: u16, _: u8) {
+        self.incoming.clear();
+        self.aborted += 1;
     }
 }
 
@@ -608,4 +635,62 @@ fn an_rpdo_indicates_each_mapped_entry_in_mapping_order() {
     assert_eq!((read_u8(&mut n, 0x2001), read(&mut n, 0x2003, 0), read_u8(&mut n, 0x2000)), (0x11, 0x1122_3344, 0x22));
     n.on_frame(&CanFrame::data(0x205, &[0x11, 0xEE]).unwrap(), 0);
     assert_eq!(indications(&mut n), [], "a PDO shorter than its mapping writes nothing");
+}
+
+/// A node whose 1F50h.2 streams, and CANopenIA's configuration file.
+fn streaming_node() -> (TestNode, Vec<u8>) {
+    let mut n = node(NodeConfig::new(ID), &[]);
+    n.od_mut().app.streaming = true;
+    (n, (0..2217_u32).map(|i| (i * 13 + i / 7) as u8).collect())
+}
+
+#[test]
+fn a_download_streams_into_an_app_entry_through_the_nodes_small_buffer() {
+    let (mut n, file) = streaming_node();
+    assert_eq!(download_segmented(&mut n, 0x1F50, 2, &file), Ok(()), "2,217 bytes through an 8-byte buffer");
+    assert_eq!(n.od().app.program, file);
+    assert_eq!(indications(&mut n), [(0x1F50, 2, vec![], WriteSource::Sdo)], "indicated once, complete");
+    assert_eq!(n.od().app.aborted, 0);
+    n.od_mut().app.streaming = false;
+    assert_eq!(download_segmented(&mut n, 0x1F50, 2, &file), Err(SdoAbort::OutOfMemory.code()), "not streaming: the buffer decides");
+    assert_eq!(download_segmented(&mut n, 0x1F50, 2, b"whole"), Ok(()));
+    assert_eq!((n.od().app.program.as_slice(), n.od().app.aborted), (&b"whole"[..], 0));
+}
+
+#[test]
+fn nmt_commands_that_drop_a_streamed_download_abort_it_once() {
+    let (mut n, file) = streaming_node();
+    for (cs, what) in [(0x82, "reset communication"), (0x81, "reset node"), (0x02, "stop")] {
+        n.od_mut().app.aborted = 0;
+        assert_eq!(outcome(sdo(&mut n, initiate_segmented(0x1F50, 2, file.len()))), Ok(()));
+        assert_eq!(outcome(sdo(&mut n, download_segment(0, &file[..7], false))), Ok(()));
+        nmt(&mut n, cs, ID);
+        frames(&mut n, 0);
+        assert_eq!(n.od().app.aborted, 1, "{what}");
+        nmt(&mut n, 0x80, ID);
+        frames(&mut n, 0);
+        assert_eq!(download_segmented(&mut n, 0x1F50, 2, &file), Ok(()), "after {what}");
+        assert_eq!((n.od().app.program.as_slice(), n.od().app.aborted), (file.as_slice(), 1), "after {what}");
+    }
+    nmt(&mut n, 0x01, ID);
+    assert_eq!(outcome(sdo(&mut n, initiate_segmented(0x1F50, 2, file.len()))), Ok(()));
+    nmt(&mut n, 0x80, ID);
+    assert_eq!(n.od().app.aborted, 1, "a state change SDO survives leaves the transfer running");
+}
+
+#[test]
+fn the_node_keeps_a_stream_within_the_entrys_maximum() {
+    let (mut n, _) = streaming_node();
+    assert_eq!(outcome(sdo(&mut n, initiate_segmented(0x1F50, 2, usize::from(PROGRAM_MAX) + 1))), Err(SdoAbort::LengthTooHigh.code()));
+    assert_eq!(n.od().app.aborted, 0, "refused at initiation: no stream");
+    // Without a size, the part that goes past 4,000 bytes is refused.
+    let [lo, hi] = 0x1F50_u16.to_le_bytes();
+    assert_eq!(outcome(sdo(&mut n, [0x20, lo, hi, 2, 0, 0, 0, 0])), Ok(()));
+    let parts = usize::from(PROGRAM_MAX).div_ceil(7);
+    for i in 0..parts - 1 {
+        assert_eq!(outcome(sdo(&mut n, download_segment(i, &[i as u8; 7], false))), Ok(()), "segment {i}");
+    }
+    assert_eq!(outcome(sdo(&mut n, download_segment(parts - 1, &[0; 7], true))), Err(SdoAbort::LengthTooHigh.code()));
+    assert_eq!(n.od().app.aborted, 1);
+    assert_eq!(indications(&mut n), [], "nothing completed");
 }
