@@ -4,7 +4,7 @@
 //! ```text
 //! board ──on_frame(frame, now)──▶ Node ──poll(now)──▶ frames to send
 //!                                   │
-//!          write/raise/trigger_tpdo/trigger_mapped (device code)
+//!   write/raise/trigger_tpdo/trigger_mapped/send_frame (device code)
 //! ```
 //! All times are microseconds from an arbitrary epoch; the node never reads a clock itself.
 //! Deadlines saturate at `u64::MAX` (584 000 years) rather than overflow.
@@ -12,8 +12,9 @@
 //! Every write that takes effect is indicated to the dictionary's app objects
 //! ([`AppObjects::written`](crate::od::AppObjects::written)): SDO downloads, each entry an
 //! RPDO writes, [`Node::write`] by the host or the device, 1010h/1011h commands that
-//! succeeded. A refused write, or one whose auto-save failed (answered `Hardware`), is not
-//! indicated; nor are [`Node::od_mut`] accesses and the node's own bookkeeping (1001h, 1003h).
+//! succeeded, a streamed download once its last part is taken (with empty data). A refused
+//! write, or one whose auto-save failed (answered `Hardware`), is not indicated; nor are
+//! [`Node::od_mut`] accesses and the node's own bookkeeping (1001h, 1003h).
 //!
 //! - `target`: writes with their side effects, and the SDO server's view of the node;
 //! - `comm`: the CiA 301 rules for writes to communication objects (PDO remapping and more);
