@@ -358,20 +358,32 @@ impl<const N: usize> SdoServer<N> {
         }
     }
 
-    /// Ends the transfer with an abort frame. Called from many places: kept out of line.
-    #[inline(never)]
+    /// Ends the transfer with an abort frame, telling a streamed download's target. Inlined:
+    /// without streaming it is the plain `send_abort`, as before streaming existed.
+    #[inline(always)]
     fn abort<T: SdoTarget>(&mut self, mux: Mux, code: SdoAbort, target: &mut T) -> Option<[u8; 8]> {
-        self.drop_transfer(target);
+        self.end_stream(target);
+        self.send_abort(mux, code)
+    }
+
+    fn send_abort(&mut self, mux: Mux, code: SdoAbort) -> Option<[u8; 8]> {
+        self.state = State::Idle;
         Some(command::abort_frame(mux, code))
     }
 
-    /// Ends the transfer in progress without success: the one place a streamed download's
-    /// target hears that it failed.
+    /// Ends the transfer in progress without success (nothing is sent).
     fn drop_transfer<T: SdoTarget>(&mut self, target: &mut T) {
-        let dropped = core::mem::replace(&mut self.state, State::Idle);
+        self.end_stream(target);
+        self.state = State::Idle;
+    }
+
+    /// The one place a streamed download's target hears that it failed: called as any
+    /// transfer ends without success, it tells a streamed download's target once.
+    fn end_stream<T: SdoTarget>(&mut self, target: &mut T) {
         if T::STREAMING
-            && let Some(mux) = dropped.streamed()
+            && let Some(mux) = self.state.streamed()
         {
+            self.state = State::Idle;
             target.abort_stream(mux.index, mux.sub);
         }
     }
