@@ -85,8 +85,8 @@
 //!   are 127 segments, as no buffer limits them.
 //! - **Failure**: every way a streamed download ends without its last part accepted (abort
 //!   from either side, timeout, toggle, length or CRC error, a refused part, NMT reset or
-//!   stop through [`SdoServer::reset`], a new initiate) calls `abort_stream` exactly once,
-//!   before anything the new initiate asks.
+//!   stop through [`SdoServer::reset`], a new initiate) calls `abort_stream` exactly once;
+//!   for a new initiate, before the target is asked anything about the new transfer.
 
 mod block;
 mod command;
