@@ -1,7 +1,8 @@
 //! `app::Hooks`: one typed hook per app-backed object or group of repeated objects, and
 //! `app::Typed<H>`, the `AppObjects` that routes the dictionary's app reads and writes to
 //! them. The owner of an object handles its reads and writes; the device names objects by
-//! hook, never by number.
+//! hook, never by number. `Hooks` also carries the provided `AppObjects` hooks (write
+//! indications, streamed SDO downloads) by index, which `Typed` forwards.
 //!
 //! A group is the objects one `repeat` template made (they share its span), in index order:
 //! CO401Memory1's 64 memory blocks are one hook taking the block number `n`, CR3101's
@@ -194,8 +195,30 @@ pub fn app_module(d: &Device, options: &Options) -> TokenStream {
             /// their data and answers their reads and writes. The dictionary has made the
             /// access, length and value checks before a hook runs; `n` is the object's place
             /// in its group, `sub` the sub-index accessed.
+            ///
+            /// The provided hooks are the `AppObjects` ones of the same names (write
+            /// indications, streamed SDO downloads): empty unless the device overrides them.
             pub trait Hooks {
                 #(#hooks)*
+
+                /// A write of a local entry took effect (`AppObjects::written`).
+                fn written(&mut self, _index: u16, _sub: u8, _data: &[u8], _by: #stack::od::WriteSource) {}
+
+                /// Whether any object streams its SDO downloads (`AppObjects::STREAMING`).
+                const STREAMING: bool = false;
+
+                /// Whether an SDO download of this app-backed entry streams (`AppObjects::streams`).
+                fn streams(&mut self, _index: u16, _sub: u8) -> bool {
+                    false
+                }
+
+                /// The next part of a streamed download (`AppObjects::write_part`).
+                fn write_part(&mut self, _index: u16, _sub: u8, _offset: usize, _data: &[u8], _last: bool) -> Result<(), #stack::od::SdoAbort> {
+                    Err(#stack::od::SdoAbort::UnsupportedAccess)
+                }
+
+                /// A streamed download failed (`AppObjects::abort_stream`).
+                fn abort_stream(&mut self, _index: u16, _sub: u8) {}
             }
 
             /// The dictionary's `AppObjects`: routes each app-backed access to its hook.
@@ -231,6 +254,24 @@ pub fn app_module(d: &Device, options: &Options) -> TokenStream {
                         // Read-only app objects: only the device itself could try.
                         _ => Err(#stack::od::SdoAbort::ReadOnly),
                     }
+                }
+
+                fn written(&mut self, index: u16, sub: u8, data: &[u8], by: #stack::od::WriteSource) {
+                    self.0.written(index, sub, data, by)
+                }
+
+                const STREAMING: bool = H::STREAMING;
+
+                fn streams(&mut self, _: &#stack::od::EntryInfo, index: u16, sub: u8) -> bool {
+                    self.0.streams(index, sub)
+                }
+
+                fn write_part(&mut self, _: &#stack::od::EntryInfo, index: u16, sub: u8, offset: usize, data: &[u8], last: bool) -> Result<(), #stack::od::SdoAbort> {
+                    self.0.write_part(index, sub, offset, data, last)
+                }
+
+                fn abort_stream(&mut self, _: &#stack::od::EntryInfo, index: u16, sub: u8) {
+                    self.0.abort_stream(index, sub)
                 }
             }
         }

@@ -358,7 +358,7 @@ fn protocol_switch_threshold_falls_back_to_a_normal_upload() {
     // 19 bytes <= pst 19: segmented.
     assert_eq!(b.req(&[0xA4, 0x02, 0x20, 0, 10, 19, 0, 0]), Some(with_mux(0x41, STRING, [19, 0, 0, 0])));
     assert_eq!(b.req(&[0x60]), Some(segment(0x00, b"coforge")));
-    b.server.reset();
+    b.server.reset(&mut b.dict);
     // 19 bytes > pst 18: block.
     assert_eq!(b.req(&[0xA4, 0x02, 0x20, 0, 10, 18, 0, 0]), Some(with_mux(0xC6, STRING, [19, 0, 0, 0])));
     // pst 0: no switch, even for 4 bytes.
@@ -448,7 +448,7 @@ fn reset_drops_the_transfer() {
     let mut b = Bench::<64>::new();
     b.req(&with_mux(0x20, STRING, [0; 4]));
     assert!(!b.server.is_idle());
-    b.server.reset();
+    b.server.reset(&mut b.dict);
     assert!(b.server.is_idle());
     b.now = 10_000_000;
     assert_eq!(b.poll(), None, "no timeout for a dropped transfer");

@@ -4,10 +4,17 @@
 //! ```text
 //! board ──on_frame(frame, now)──▶ Node ──poll(now)──▶ frames to send
 //!                                   │
-//!          write/raise/trigger_tpdo/trigger_mapped (device code)
+//!   write/raise/trigger_tpdo/trigger_mapped/send_frame (device code)
 //! ```
 //! All times are microseconds from an arbitrary epoch; the node never reads a clock itself.
 //! Deadlines saturate at `u64::MAX` (584 000 years) rather than overflow.
+//!
+//! Every write that takes effect is indicated to the dictionary's app objects
+//! ([`AppObjects::written`](crate::od::AppObjects::written)): SDO downloads, each entry an
+//! RPDO writes, [`Node::write`] by the host or the device, 1010h/1011h commands that
+//! succeeded, a streamed download once its last part is taken (with empty data). A refused
+//! write, or one whose auto-save failed (answered `Hardware`), is not indicated; nor are
+//! [`Node::od_mut`] accesses and the node's own bookkeeping (1001h, 1003h).
 //!
 //! - `target`: writes with their side effects, and the SDO server's view of the node;
 //! - `comm`: the CiA 301 rules for writes to communication objects (PDO remapping and more);
@@ -29,7 +36,7 @@ use crate::guarding::{GuardEvent, Guarding};
 use crate::heartbeat::{Consumer, ConsumerEvent, Producer};
 use crate::leds::Leds;
 use crate::nmt::{self, NmtCommand, NmtState};
-use crate::od::{AccessContext, Area, EntryAccess, NodeDictionary, SdoAbort, Side};
+use crate::od::{AccessContext, Area, EntryAccess, NodeDictionary, SdoAbort, Side, WriteSource};
 use crate::pdo::mapping::Mapping;
 use crate::pdo::slot::NEVER;
 use crate::pdo::{Dir, Rpdo, Tpdo};
@@ -247,7 +254,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
             self.core.event(NodeEvent::NmtReceived(cs));
             if let Some(cmd) = NmtCommand::from_code(cs) {
                 if matches!(cmd, NmtCommand::ResetNode | NmtCommand::ResetCommunication | NmtCommand::Stop) {
-                    self.sdo.reset();
+                    self.sdo.reset(&mut self.core);
                 }
                 self.core.nmt_command(cmd, now_us);
             }
@@ -310,9 +317,9 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
 
     /// A write by the device itself or its serial host, with the same side effects as an SDO
     /// download: communication-object checks, event-driven TPDOs (with `tpdo_on_write`),
-    /// auto-save.
+    /// auto-save, and the write indication (a `Side::Bus` write is indicated as an SDO one).
     pub fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
-        self.core.write(index, sub, data, side)
+        self.core.write_indicated(index, sub, data, WriteSource::of_side(side))
     }
 
     /// A read on behalf of `side`.
@@ -398,6 +405,14 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
     /// Frames the node could not queue (its transmit queue was full).
     pub fn tx_overflows(&self) -> u32 {
         self.core.tx_overflows
+    }
+
+    /// Queues any frame from device code (a manager's NMT commands, say) behind the node's
+    /// own: `false` if the transmit queue was full, which counts in [`Node::tx_overflows`].
+    /// Like every node frame it goes out through [`Node::poll`] only while the CAN side is
+    /// enabled and not bus-off, and the boot-up (power-on, NMT reset) empties the queue.
+    pub fn send_frame(&mut self, frame: CanFrame) -> bool {
+        self.core.queue(Some(frame))
     }
 }
 

@@ -3,7 +3,7 @@
 
 use super::{Core, NodeEvent};
 use crate::emcy::EmcyEvent;
-use crate::od::NodeDictionary;
+use crate::od::{AppObjects, NodeDictionary, WriteSource};
 use crate::pdo::Rpdo;
 use crate::store::ParamStore;
 
@@ -41,7 +41,8 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     }
 
     /// Writes a received payload to the mapped objects. An entry the dictionary refuses (a
-    /// value out of range) keeps its value; the others are written, with their side effects.
+    /// value out of range) keeps its value; the others are written, with their side effects,
+    /// and indicated one by one in mapping order (dummy entries write nothing).
     pub(super) fn apply_rpdo(&mut self, r: &Rpdo, data: &[u8]) {
         let entries = self.od.entries();
         let mut at = 0;
@@ -51,6 +52,7 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
                 && self.od.write_entry(info, m.index(info), m.sub, src).is_ok()
             {
                 self.after_write(m.index(info), m.sub);
+                self.od.app().written(m.index(info), m.sub, src, WriteSource::Rpdo);
             }
             at = end;
         }

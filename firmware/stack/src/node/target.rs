@@ -1,15 +1,25 @@
 //! Writes with their side effects, and the SDO server's view of the node.
 
 use super::{Core, read_u32};
-use crate::od::{NodeDictionary, ReadLen, SdoAbort, Side, Storage};
+use crate::od::{AppObjects, NodeDictionary, ReadLen, SdoAbort, Side, Storage, WriteSource};
 use crate::pdo::Dir;
 use crate::sdo::SdoTarget;
 use crate::store::ParamStore;
 
 impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
+    /// A write, then its indication if it took effect: the one place SDO, host and device
+    /// writes are indicated (RPDOs write entries directly, see `apply_rpdo`). Inlined, so
+    /// with the indication empty each caller is left with the plain `write` call.
+    #[inline(always)]
+    pub(super) fn write_indicated(&mut self, index: u16, sub: u8, data: &[u8], by: WriteSource) -> Result<(), SdoAbort> {
+        self.write(index, sub, data, by.side())?;
+        self.od.app().written(index, sub, data, by);
+        Ok(())
+    }
+
     /// A write from any side: the communication-object rules first, then the dictionary's
     /// own checks, then whatever the new value changes.
-    pub(super) fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
+    fn write(&mut self, index: u16, sub: u8, data: &[u8], side: Side) -> Result<(), SdoAbort> {
         let ctx = self.ctx();
         let entry = self.od.entry(index, sub)?;
         if matches!(index, 0x1010 | 0x1011) && sub >= 1 {
@@ -115,12 +125,45 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> SdoTarget for Core<D, S, 
     }
 
     fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort> {
-        Core::write(self, index, sub, data, Side::Bus)
+        self.write_indicated(index, sub, data, WriteSource::Sdo)
     }
 
     fn fixed_size(&mut self, index: u16, sub: u8) -> Option<usize> {
         let e = self.od.entry(index, sub).ok()?;
         e.data_type().bits().map(|_| usize::from(e.size))
+    }
+
+    const STREAMING: bool = <D::App as AppObjects>::STREAMING;
+
+    fn streams(&mut self, index: u16, sub: u8) -> bool {
+        match self.od.entry(index, sub) {
+            Ok(entry) if entry.storage() == Storage::App => self.od.app().streams(entry, index, sub),
+            _ => false,
+        }
+    }
+
+    /// Checked again for every part, as a whole write would be at its end: the NMT state may
+    /// have changed since the initiation, and without an indicated size only the parts show
+    /// the length. The completed download has a whole write's side effects and indication.
+    fn write_part(&mut self, index: u16, sub: u8, offset: usize, data: &[u8], last: bool) -> Result<(), SdoAbort> {
+        let ctx = self.ctx();
+        let entry = self.od.entry(index, sub)?;
+        entry.check_write_access(Side::Bus, &ctx)?;
+        if offset.saturating_add(data.len()) > usize::from(entry.size) {
+            return Err(SdoAbort::LengthTooHigh);
+        }
+        self.od.app().write_part(entry, index, sub, offset, data, last)?;
+        if last {
+            self.after_write(index, sub);
+            self.od.app().written(index, sub, &[], WriteSource::Sdo);
+        }
+        Ok(())
+    }
+
+    fn abort_stream(&mut self, index: u16, sub: u8) {
+        if let Ok(entry) = self.od.entry(index, sub) {
+            self.od.app().abort_stream(entry, index, sub);
+        }
     }
 }
 

@@ -1,13 +1,14 @@
 //! The node over a small hand-written dictionary: one RPDO and one TPDO that both map 2000h,
-//! a heartbeat consumer, and a switch object 2102h. Generated dictionaries are tested through
+//! a heartbeat consumer, a switch object 2102h, and an app-backed DOMAIN 1F50h.2 owned by a
+//! [`Recorder`] that also logs write indications. Generated dictionaries are tested through
 //! the devices (`verification`, the simulator); these tests reach the node's own rules.
 
 use super::{BusState, Node, NodeConfig, NodeEvent};
 use crate::emcy::{EmcyDefault, EmcyEvent, Reaction};
 use crate::frame::CanFrame;
 use crate::od::{
-    Access, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NoAppObjects, NodeDictionary, SdoAbort, Side,
-    Storage,
+    Access, AppObjects, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NodeDictionary, ReadLen, SdoAbort,
+    Side, Storage, WriteSource, read_slice,
 };
 use crate::store::NoStore;
 use crate::value::OdValue;
@@ -32,17 +33,31 @@ const fn entry(index: u16, sub: u8, data_type: DataType, access: Access) -> Entr
         last_sub: sub,
         limits: 0,
         kind: EntryKind::new(data_type, access),
-        flags: if index == 0x2000 || index == 0x2001 { flags.pdo_mappable() } else { flags },
+        flags: if matches!(index, 0x2000 | 0x2001 | 0x2003) { flags.pdo_mappable() } else { flags },
     }
 }
 
+/// The largest value 1F50h.2 takes.
+const PROGRAM_MAX: u16 = 4000;
+
+/// 1F50h.2: a write-only DOMAIN the app keeps (CANopenIA's configuration download).
+const PROGRAM: EntryInfo = EntryInfo {
+    size: PROGRAM_MAX,
+    kind: EntryKind::new(DataType::Domain, Access::Wo),
+    flags: EntryFlags::new(HostAccess::Wo, Storage::App),
+    ..entry(0x1F50, 2, U8, Access::Wo)
+};
+
 const U8: DataType = DataType::Unsigned8;
 const U32: DataType = DataType::Unsigned32;
+const ENTRY_COUNT: usize = 24;
 
 /// Every entry with its default (`$NODEID` added where the flag says so).
-const TABLE: [(EntryInfo, u32, bool); 17] = [
+const TABLE: [(EntryInfo, u32, bool); ENTRY_COUNT] = [
     (entry(0x1000, 0, U32, Access::Ro), 0x191, false),
     (entry(0x1001, 0, U8, Access::Ro), 0, false),
+    (entry(0x1010, 1, U32, Access::Rw), 1, false),
+    (entry(0x1011, 1, U32, Access::Rw), 1, false),
     (entry(0x1016, 0, U8, Access::Ro), 1, false),
     (entry(0x1016, 1, U32, Access::Rw), 0, false),
     (entry(0x1400, 0, U8, Access::Ro), 2, false),
@@ -50,18 +65,23 @@ const TABLE: [(EntryInfo, u32, bool); 17] = [
     (entry(0x1400, 2, U8, Access::Rw), 255, false),
     (entry(0x1600, 0, U8, Access::Rw), 1, false),
     (entry(0x1600, 1, U32, Access::Rw), 0x2000_0008, false),
+    (entry(0x1600, 2, U32, Access::Rw), 0, false),
+    (entry(0x1600, 3, U32, Access::Rw), 0, false),
+    (entry(0x1600, 4, U32, Access::Rw), 0, false),
     (entry(0x1800, 0, U8, Access::Ro), 2, false),
     (entry(0x1800, 1, U32, Access::Rw), 0x180, true),
     (entry(0x1800, 2, U8, Access::Rw), 255, false),
     (entry(0x1A00, 0, U8, Access::Rw), 1, false),
     (entry(0x1A00, 1, U32, Access::Rw), 0x2000_0008, false),
+    (PROGRAM, 0, false),
     (entry(0x2000, 0, U8, Access::Rw), 0, false),
     (entry(0x2001, 0, U8, Access::Rw), 0, false),
+    (entry(0x2003, 0, U32, Access::Rw), 0, false),
     (entry(0x2102, 0, U8, Access::Ro), 1, false),
 ];
 
-static ENTRIES: [EntryInfo; 17] = {
-    let mut out = [entry(0, 0, U8, Access::Ro); 17];
+static ENTRIES: [EntryInfo; ENTRY_COUNT] = {
+    let mut out = [entry(0, 0, U8, Access::Ro); ENTRY_COUNT];
     let mut i = 0;
     while i < out.len() {
         out[i] = TABLE[i].0;
@@ -70,17 +90,68 @@ static ENTRIES: [EntryInfo; 17] = {
     out
 };
 
+/// The owner of 1F50h.2: keeps what is written to it (streamed while `streaming` is set) and
+/// logs every write indication.
+#[derive(Debug, Default)]
+pub(super) struct Recorder {
+    /// Every indication, in order: index, sub-index, data, source.
+    written: Vec<(u16, u8, Vec<u8>, WriteSource)>,
+    /// 1F50h.2's value.
+    program: Vec<u8>,
+    streaming: bool,
+    /// The parts of a streamed download so far.
+    incoming: Vec<u8>,
+    /// Streamed downloads that ended without success.
+    aborted: usize,
+}
+
+impl AppObjects for Recorder {
+    fn read(&mut self, _: &EntryInfo, _: u16, _: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        read_slice(&self.program, offset, buf)
+    }
+
+    fn write(&mut self, _: &EntryInfo, _: u16, _: u8, data: &[u8]) -> Result<(), SdoAbort> {
+        self.program = data.to_vec();
+        Ok(())
+    }
+
+    fn written(&mut self, index: u16, sub: u8, data: &[u8], by: WriteSource) {
+        self.written.push((index, sub, data.to_vec(), by));
+    }
+
+    const STREAMING: bool = true;
+
+    fn streams(&mut self, entry: &EntryInfo, index: u16, sub: u8) -> bool {
+        assert_eq!((entry.index, index, sub), (0x1F50, 0x1F50, 2), "asked for app-backed entries only");
+        self.streaming
+    }
+
+    fn write_part(&mut self, _: &EntryInfo, _: u16, _: u8, offset: usize, data: &[u8], last: bool) -> Result<(), SdoAbort> {
+        assert_eq!(offset, self.incoming.len(), "in order, without gaps");
+        self.incoming.extend_from_slice(data);
+        if last {
+            self.program = core::mem::take(&mut self.incoming);
+        }
+        Ok(())
+    }
+
+    fn abort_stream(&mut self, _: &EntryInfo, _: u16, _: u8) {
+        self.incoming.clear();
+        self.aborted += 1;
+    }
+}
+
 /// The test dictionary: each entry's value in a byte or a word, by its place in the table.
 #[derive(Debug)]
 pub(super) struct TestOd {
-    bytes: [u8; 17],
-    words: [u32; 17],
+    bytes: [u8; ENTRY_COUNT],
+    words: [u32; ENTRY_COUNT],
     emergencies: &'static [EmcyDefault],
-    app: NoAppObjects,
+    app: Recorder,
 }
 
 impl EntryAccess for TestOd {
-    type App = NoAppObjects;
+    type App = Recorder;
 
     fn entries(&self) -> &'static [EntryInfo] {
         &ENTRIES
@@ -95,7 +166,7 @@ impl EntryAccess for TestOd {
         if info.size == 1 { Some(&mut self.bytes[at]) } else { Some(&mut self.words[at]) }
     }
 
-    fn app(&mut self) -> &mut NoAppObjects {
+    fn app(&mut self) -> &mut Recorder {
         &mut self.app
     }
 }
@@ -133,8 +204,8 @@ impl NodeDictionary for TestOd {
         None
     }
 
-    fn new(_: (), node_id: u8, app: NoAppObjects) -> Self {
-        let mut od = TestOd { bytes: [0; 17], words: [0; 17], emergencies: &[], app };
+    fn new(_: (), node_id: u8, app: Recorder) -> Self {
+        let mut od = TestOd { bytes: [0; ENTRY_COUNT], words: [0; ENTRY_COUNT], emergencies: &[], app };
         od.reset_area(Area::ALL, node_id);
         od
     }
@@ -157,7 +228,7 @@ type TestNode = Node<TestOd, NoStore, 8, 1>;
 /// A started node with the spec emergencies `emergencies`, its boot-up sent and its events
 /// taken.
 fn node(cfg: NodeConfig, emergencies: &'static [EmcyDefault]) -> TestNode {
-    let mut od = TestOd::new((), ID, NoAppObjects);
+    let mut od = TestOd::new((), ID, Recorder::default());
     od.emergencies = emergencies;
     let mut n = Node::new(od, NoStore, cfg);
     n.start(0);
@@ -432,4 +503,194 @@ fn without_a_remapping_object_mappings_follow_cia_301_alone() {
     assert_eq!(n.write(0x1A00, 1, &0x2001_0008_u32.to_le_bytes(), Side::Device), Ok(()), "the device may");
     assert_eq!(download(&mut n, 0x1800, 1, &(0x8000_0180 + u32::from(ID)).to_le_bytes()), Ok(()));
     assert_eq!(download(&mut n, 0x1A00, 0, &[0]), Ok(()));
+}
+
+#[test]
+fn device_frames_queue_behind_the_nodes_own_and_count_when_lost() {
+    let mut n = node(NodeConfig::new(ID), &[]);
+    let nmt_start = CanFrame::data(0x000, &[0x01, 0]).unwrap();
+    let queued: Vec<bool> = (0..13).map(|i| n.send_frame(CanFrame { data: [i, 0, 0, 0, 0, 0, 0, 0], ..nmt_start })).collect();
+    assert_eq!(queued, [[true; 12].as_slice(), &[false]].concat(), "the queue holds 12 frames");
+    assert_eq!(n.tx_overflows(), 1, "the lost one is counted");
+    let sent = frames(&mut n, 0);
+    assert_eq!(sent.iter().map(|f| f.data[0]).collect::<Vec<u8>>(), (0..12).collect::<Vec<u8>>(), "sent in order, unchanged");
+    assert!(sent.iter().all(|f| f.id == 0 && f.dlc == 2));
+    assert!(n.send_frame(nmt_start), "room again once sent");
+    assert_eq!(frames(&mut n, 0), [nmt_start]);
+}
+
+#[test]
+fn device_frames_wait_for_the_can_side() {
+    let mut n: TestNode = Node::new(TestOd::new((), ID, Recorder::default()), NoStore, NodeConfig::new(ID));
+    n.power_on(0);
+    let frame = CanFrame::data(0x123, &[1, 2, 3]).unwrap();
+    assert!(n.send_frame(frame));
+    assert_eq!(frames(&mut n, 0), [], "nothing goes out before the CAN side is enabled");
+    n.enable_can((), 0);
+    assert_eq!(frames(&mut n, 0), [CanFrame::data(0x700 + u16::from(ID), &[0]).unwrap()], "the boot-up empties the queue");
+    assert!(n.send_frame(frame));
+    n.on_bus_state(BusState::BusOff, 0);
+    assert_eq!(frames(&mut n, 0), [], "a bus-off controller sends nothing");
+}
+
+/// One SDO request and the node's answer to it (other frames are dropped).
+fn sdo(n: &mut TestNode, request: [u8; 8]) -> [u8; 8] {
+    n.on_frame(&CanFrame::data(0x600 + u16::from(ID), &request).unwrap(), 0);
+    let answers: Vec<[u8; 8]> = frames(n, 0).into_iter().filter(|f| f.id == 0x580 + u16::from(ID)).map(|f| f.data).collect();
+    let [answer] = answers[..] else { panic!("one SDO answer, not {answers:?}") };
+    answer
+}
+
+/// The abort code of an SDO answer, or `Ok` for any other answer.
+fn outcome(answer: [u8; 8]) -> Result<(), u32> {
+    if answer[0] == 0x80 { Err(u32::from_le_bytes([answer[4], answer[5], answer[6], answer[7]])) } else { Ok(()) }
+}
+
+fn initiate_segmented(index: u16, sub: u8, size: usize) -> [u8; 8] {
+    let [lo, hi] = index.to_le_bytes();
+    let [s0, s1, s2, s3] = (size as u32).to_le_bytes();
+    [0x21, lo, hi, sub, s0, s1, s2, s3]
+}
+
+/// Download segment `i` of a transfer (toggle from `i`), `last` if no more follow.
+fn download_segment(i: usize, chunk: &[u8], last: bool) -> [u8; 8] {
+    let mut frame = [0; 8];
+    frame[0] = (i as u8 & 1) << 4 | (7 - chunk.len() as u8) << 1 | u8::from(last);
+    frame[1..1 + chunk.len()].copy_from_slice(chunk);
+    frame
+}
+
+/// A segmented download with the size indicated: `Err` with the abort code of the first
+/// request the node refuses.
+fn download_segmented(n: &mut TestNode, index: u16, sub: u8, value: &[u8]) -> Result<(), u32> {
+    outcome(sdo(n, initiate_segmented(index, sub, value.len())))?;
+    let chunks: Vec<&[u8]> = value.chunks(7).collect();
+    for (i, chunk) in chunks.iter().enumerate() {
+        let answer = sdo(n, download_segment(i, chunk, i + 1 == chunks.len()));
+        outcome(answer)?;
+        assert_eq!(answer[0], 0x20 | (i as u8 & 1) << 4, "segment {i} acknowledged");
+    }
+    Ok(())
+}
+
+/// The write indications so far, taken.
+fn indications(n: &mut TestNode) -> Vec<(u16, u8, Vec<u8>, WriteSource)> {
+    core::mem::take(&mut n.od_mut().app.written)
+}
+
+#[test]
+fn sdo_host_and_device_writes_are_indicated_after_they_took_effect() {
+    let mut n = operational(NodeConfig::new(ID));
+    let (result, sent) = download_with(&mut n, 0x2000, 0, &[9]);
+    assert_eq!((result, tpdo1(&sent)), (Ok(()), vec![vec![9]]), "written, TPDO1 triggered");
+    assert_eq!(indications(&mut n), [(0x2000, 0, vec![9], WriteSource::Sdo)], "an expedited download");
+    assert_eq!(download_segmented(&mut n, 0x2003, 0, &[1, 2, 3, 4]), Ok(()));
+    assert_eq!(indications(&mut n), [(0x2003, 0, vec![1, 2, 3, 4], WriteSource::Sdo)], "a segmented download");
+    assert_eq!(download_segmented(&mut n, 0x1F50, 2, b"config"), Ok(()));
+    assert_eq!(n.od().app.program, b"config", "an app-backed entry");
+    assert_eq!(indications(&mut n), [(0x1F50, 2, b"config".to_vec(), WriteSource::Sdo)]);
+    assert_eq!(n.write(0x2001, 0, &[3], Side::Host), Ok(()));
+    assert_eq!(n.write(0x2001, 0, &[4], Side::Device), Ok(()));
+    assert_eq!(n.write(0x2001, 0, &[5], Side::Bus), Ok(()));
+    let expected = [(0x2001, 0, vec![3], WriteSource::Host), (0x2001, 0, vec![4], WriteSource::Device), (0x2001, 0, vec![5], WriteSource::Sdo)];
+    assert_eq!(indications(&mut n), expected, "the node's write names its side; the bus's is an SDO download");
+    assert_eq!(read_u8(&mut n, 0x2001), 5);
+}
+
+#[test]
+fn refused_and_failed_writes_are_not_indicated() {
+    let mut n = operational(NodeConfig::new(ID));
+    assert_eq!(download(&mut n, 0x2102, 0, &[0]), Err(SdoAbort::ReadOnly.code()));
+    assert_eq!(download(&mut n, 0x2000, 0, &[1, 2]), Err(SdoAbort::LengthTooHigh.code()));
+    assert_eq!(download_segmented(&mut n, 0x2003, 0, &[1, 2, 3, 4, 5]), Err(SdoAbort::LengthTooHigh.code()));
+    assert_eq!(download(&mut n, 0x9999, 0, &[1]), Err(SdoAbort::NoObject.code()));
+    assert_eq!(n.write(0x2003, 0, &[1, 2], Side::Host), Err(SdoAbort::LengthTooLow));
+    assert_eq!(n.write(0x2102, 0, &[0], Side::Bus), Err(SdoAbort::ReadOnly));
+    assert_eq!(n.write(0x2000, 0, &[], Side::Device), Err(SdoAbort::LengthTooLow));
+    assert_eq!(n.write(0x1A00, 0, &[0], Side::Host), Err(SdoAbort::DataTransferState), "a communication rule");
+    assert_eq!(download(&mut n, 0x1010, 1, b"sav!"), Err(SdoAbort::DataTransfer.code()), "a wrong signature");
+    assert_eq!(download(&mut n, 0x1010, 1, b"save"), Err(SdoAbort::Hardware.code()), "a store that fails");
+    assert_eq!(indications(&mut n), [], "nothing was written");
+    assert_eq!(read_u8(&mut n, 0x2000), 0);
+    assert_eq!(download(&mut n, 0x1011, 1, b"load"), Ok(()));
+    assert_eq!(indications(&mut n), [(0x1011, 1, b"load".to_vec(), WriteSource::Sdo)], "a restore that succeeded is a write");
+}
+
+#[test]
+fn an_rpdo_indicates_each_mapped_entry_in_mapping_order() {
+    let mut n = node(NodeConfig::new(ID), &[]);
+    let rpdo1 = 0x200 + u32::from(ID);
+    // RPDO1 maps 2001h, a dummy byte, 2003h and 2000h (CiA 301 remapping procedure).
+    let mapping = [(0x1400, 1, 0x8000_0000 | rpdo1), (0x1600, 0, 0), (0x1600, 1, 0x2001_0008), (0x1600, 2, 0x0005_0008)];
+    let mapping = [&mapping[..], &[(0x1600, 3, 0x2003_0020), (0x1600, 4, 0x2000_0008), (0x1600, 0, 4), (0x1400, 1, rpdo1)]].concat();
+    for (index, sub, value) in mapping {
+        assert_eq!(n.write(index, sub, &value_of(sub, value), Side::Device), Ok(()), "{index:04X}.{sub}");
+    }
+    assert_eq!(indications(&mut n).len(), 8, "each configuration write");
+    nmt(&mut n, 0x01, ID);
+    n.on_frame(&CanFrame::data(0x205, &[0x11, 0xEE, 0x44, 0x33, 0x22, 0x11, 0x22]).unwrap(), 0);
+    let expected =
+        [(0x2001, 0, vec![0x11], WriteSource::Rpdo), (0x2003, 0, vec![0x44, 0x33, 0x22, 0x11], WriteSource::Rpdo), (0x2000, 0, vec![0x22], WriteSource::Rpdo)];
+    assert_eq!(indications(&mut n), expected, "three entries, the dummy byte skipped");
+    assert_eq!((read_u8(&mut n, 0x2001), read(&mut n, 0x2003, 0), read_u8(&mut n, 0x2000)), (0x11, 0x1122_3344, 0x22));
+    n.on_frame(&CanFrame::data(0x205, &[0x11, 0xEE]).unwrap(), 0);
+    assert_eq!(indications(&mut n), [], "a PDO shorter than its mapping writes nothing");
+}
+
+/// A node whose 1F50h.2 streams, and CANopenIA's configuration file.
+fn streaming_node() -> (TestNode, Vec<u8>) {
+    let mut n = node(NodeConfig::new(ID), &[]);
+    n.od_mut().app.streaming = true;
+    (n, (0..2217_u32).map(|i| (i * 13 + i / 7) as u8).collect())
+}
+
+#[test]
+fn a_download_streams_into_an_app_entry_through_the_nodes_small_buffer() {
+    let (mut n, file) = streaming_node();
+    assert_eq!(download_segmented(&mut n, 0x1F50, 2, &file), Ok(()), "2,217 bytes through an 8-byte buffer");
+    assert_eq!(n.od().app.program, file);
+    assert_eq!(indications(&mut n), [(0x1F50, 2, vec![], WriteSource::Sdo)], "indicated once, complete");
+    assert_eq!(n.od().app.aborted, 0);
+    n.od_mut().app.streaming = false;
+    assert_eq!(download_segmented(&mut n, 0x1F50, 2, &file), Err(SdoAbort::OutOfMemory.code()), "not streaming: the buffer decides");
+    assert_eq!(download_segmented(&mut n, 0x1F50, 2, b"whole"), Ok(()));
+    assert_eq!((n.od().app.program.as_slice(), n.od().app.aborted), (&b"whole"[..], 0));
+}
+
+#[test]
+fn nmt_commands_that_drop_a_streamed_download_abort_it_once() {
+    let (mut n, file) = streaming_node();
+    for (cs, what) in [(0x82, "reset communication"), (0x81, "reset node"), (0x02, "stop")] {
+        n.od_mut().app.aborted = 0;
+        assert_eq!(outcome(sdo(&mut n, initiate_segmented(0x1F50, 2, file.len()))), Ok(()));
+        assert_eq!(outcome(sdo(&mut n, download_segment(0, &file[..7], false))), Ok(()));
+        nmt(&mut n, cs, ID);
+        frames(&mut n, 0);
+        assert_eq!(n.od().app.aborted, 1, "{what}");
+        nmt(&mut n, 0x80, ID);
+        frames(&mut n, 0);
+        assert_eq!(download_segmented(&mut n, 0x1F50, 2, &file), Ok(()), "after {what}");
+        assert_eq!((n.od().app.program.as_slice(), n.od().app.aborted), (file.as_slice(), 1), "after {what}");
+    }
+    nmt(&mut n, 0x01, ID);
+    assert_eq!(outcome(sdo(&mut n, initiate_segmented(0x1F50, 2, file.len()))), Ok(()));
+    nmt(&mut n, 0x80, ID);
+    assert_eq!(n.od().app.aborted, 1, "a state change SDO survives leaves the transfer running");
+}
+
+#[test]
+fn the_node_keeps_a_stream_within_the_entrys_maximum() {
+    let (mut n, _) = streaming_node();
+    assert_eq!(outcome(sdo(&mut n, initiate_segmented(0x1F50, 2, usize::from(PROGRAM_MAX) + 1))), Err(SdoAbort::LengthTooHigh.code()));
+    assert_eq!(n.od().app.aborted, 0, "refused at initiation: no stream");
+    // Without a size, the part that goes past 4,000 bytes is refused.
+    let [lo, hi] = 0x1F50_u16.to_le_bytes();
+    assert_eq!(outcome(sdo(&mut n, [0x20, lo, hi, 2, 0, 0, 0, 0])), Ok(()));
+    let parts = usize::from(PROGRAM_MAX).div_ceil(7);
+    for i in 0..parts - 1 {
+        assert_eq!(outcome(sdo(&mut n, download_segment(i, &[i as u8; 7], false))), Ok(()), "segment {i}");
+    }
+    assert_eq!(outcome(sdo(&mut n, download_segment(parts - 1, &[0; 7], true))), Err(SdoAbort::LengthTooHigh.code()));
+    assert_eq!(n.od().app.aborted, 1);
+    assert_eq!(indications(&mut n), [], "nothing completed");
 }

@@ -1,7 +1,7 @@
 //! The traits generated dictionaries implement: entry access (`EntryAccess`), what a node
 //! needs beyond it (`NodeDictionary`), and the owner of app-backed objects (`AppObjects`).
 
-use super::{AccessContext, EntryInfo, Limits, ReadLen, SdoAbort, Side, find};
+use super::{AccessContext, EntryInfo, Limits, ReadLen, SdoAbort, Side, WriteSource, find};
 use crate::value::OdValue;
 use coforge_types::Storage;
 
@@ -193,9 +193,49 @@ pub fn mode_named<D: NodeDictionary>(name: Option<&str>) -> Result<D::Mode, &'st
 /// the generated dictionary routes their reads and writes here, after its access checks.
 /// `entry` may describe a run of sub-indices and of repeated objects; `index`/`sub` is the one
 /// accessed.
+///
+/// The owner of the objects also hears about writes (CANopenNode's OD extension idea): the
+/// provided hooks do nothing and inline to nothing, so a device that does not override them
+/// carries no code for them.
 pub trait AppObjects {
     fn read(&mut self, entry: &EntryInfo, index: u16, sub: u8, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort>;
     fn write(&mut self, entry: &EntryInfo, index: u16, sub: u8, data: &[u8]) -> Result<(), SdoAbort>;
+
+    /// A write of the local entry `index`/`sub` took effect, any entry (not only app-backed
+    /// ones): `data` as written, `by` whoever wrote it. The node calls it once per successful
+    /// write, after the write's side effects (TPDO triggers, reloaded services, auto-save),
+    /// and never for a refused or failed one; see [`crate::node`] for which writes count. A
+    /// streamed download is indicated once complete, with empty `data`: its bytes went to
+    /// [`AppObjects::write_part`].
+    fn written(&mut self, _index: u16, _sub: u8, _data: &[u8], _by: WriteSource) {}
+
+    /// Whether any entry streams (below). If not, the constant being false, the SDO server's
+    /// streaming code is not in the image.
+    const STREAMING: bool = false;
+
+    /// Whether a segmented or block SDO download of the app-backed entry `index`/`sub`,
+    /// initiated and checked (access, indicated size against the entry's maximum), is taken
+    /// in parts ([`AppObjects::write_part`]) rather than collected in the SDO server's buffer,
+    /// which may then be much smaller than the value. Expedited downloads and host or device
+    /// writes always come whole through [`AppObjects::write`]; a block download streams only
+    /// with its size indicated. Asked only if [`AppObjects::STREAMING`].
+    fn streams(&mut self, _entry: &EntryInfo, _index: u16, _sub: u8) -> bool {
+        false
+    }
+
+    /// The next part of a streamed download: `data` belongs at byte `offset`; parts come in
+    /// order without gaps and never past the entry's maximum. `last`: the download is
+    /// complete and checked (block download: length and CRC), so the value may take effect;
+    /// the last part may be empty. An error aborts the transfer with that code.
+    fn write_part(&mut self, _entry: &EntryInfo, _index: u16, _sub: u8, _offset: usize, _data: &[u8], _last: bool) -> Result<(), SdoAbort> {
+        Err(SdoAbort::UnsupportedAccess)
+    }
+
+    /// A streamed download ended without success (client abort, timeout, toggle, length or
+    /// CRC error, NMT reset or stop, a new initiate, an error of `write_part` itself): what
+    /// its parts wrote is void. Called exactly once for every streamed download that does
+    /// not end with `write_part(.., last = true)` succeeding.
+    fn abort_stream(&mut self, _entry: &EntryInfo, _index: u16, _sub: u8) {}
 }
 
 /// For devices without app-backed objects: nothing is routed here.

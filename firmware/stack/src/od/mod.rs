@@ -6,7 +6,8 @@
 //! sides (bus and host) refuse the same things with the same CiA 301 abort code.
 //!
 //! - [`abort`]: the CiA 301 SDO abort codes;
-//! - [`side`]: who accesses ([`Side`]) and the state a write is judged in ([`AccessContext`]);
+//! - [`side`]: who accesses ([`Side`]), where a write came from ([`WriteSource`]) and the
+//!   state a write is judged in ([`AccessContext`]);
 //! - [`entry`]: [`EntryInfo`], an entry's (or a run's) metadata, and its access checks;
 //! - [`lookup`]: finding a run in a generated table, copying values out;
 //! - [`dictionary`]: the two traits a generated dictionary implements, [`EntryAccess`]
@@ -25,7 +26,7 @@ pub use coforge_types::{Access, DataType, HostAccess, NmtState, Storage};
 pub use dictionary::{AppObjects, Area, CommObjects, EntryAccess, NoAppObjects, NodeDictionary, mode_named};
 pub use entry::{EntryFlags, EntryInfo, EntryKind, Limits, ReadLen, decode_int};
 pub use lookup::{find, find_run, read_slice};
-pub use side::{AccessContext, NmtStates, Side};
+pub use side::{AccessContext, NmtStates, Side, WriteSource};
 
 #[cfg(test)]
 pub(crate) use entry::test_entry;

@@ -13,6 +13,42 @@ pub enum Side {
     Device,
 }
 
+/// Where a write came from, as [`AppObjects::written`](super::AppObjects::written) reports
+/// it: the [`Side`] whose access rules it followed, with the bus split into its two services
+/// (SDO and RPDO follow the same rules, so `Side` does not tell them apart).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WriteSource {
+    /// An SDO download (expedited, segmented or block).
+    Sdo,
+    /// The serial host.
+    Host,
+    /// The device's own code.
+    Device,
+    /// A received PDO, one write per mapped entry.
+    Rpdo,
+}
+
+impl WriteSource {
+    /// The side whose access rules the write follows.
+    pub const fn side(self) -> Side {
+        match self {
+            WriteSource::Sdo | WriteSource::Rpdo => Side::Bus,
+            WriteSource::Host => Side::Host,
+            WriteSource::Device => Side::Device,
+        }
+    }
+
+    /// A write made on behalf of `side` through the node's own write: a bus write there
+    /// stands for an SDO download (RPDOs are written by the node alone).
+    pub const fn of_side(side: Side) -> WriteSource {
+        match side {
+            Side::Bus => WriteSource::Sdo,
+            Side::Host => WriteSource::Host,
+            Side::Device => WriteSource::Device,
+        }
+    }
+}
+
 /// A set of NMT states, for entries that may only be written in some of them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct NmtStates(u8);

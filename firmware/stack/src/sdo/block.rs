@@ -1,6 +1,7 @@
 //! Block transfer (CiA 301 7.2.4.3.9 to 7.2.4.3.16), with the optional CRC.
 //!
-//! Download collects the value in the server's buffer and writes it after the end request;
+//! Download collects the value in the server's buffer and writes it after the end request,
+//! or, streaming, hands each in-order segment to the target and checks the CRC as it goes;
 //! upload reads each segment from the target by offset, so it needs no buffer at all and
 //! can resend any segment the client did not acknowledge.
 
@@ -55,6 +56,10 @@ pub(super) struct Download {
     size: Option<usize>,
     /// Both sides support CRC: the client said so, the server always does.
     crc: bool,
+    /// Each in-order segment goes to the target at once ([`SdoTarget::write_part`]).
+    pub(super) stream: bool,
+    /// Streaming: the CRC of the bytes handed over so far.
+    crc_so_far: u16,
     /// Segments in the current sub-block, as last announced.
     blksize: u8,
     /// Segments of the current sub-block received in order.
@@ -67,15 +72,18 @@ pub(super) struct Download {
     ended: bool,
 }
 
-/// Initiate block download.
-pub(super) fn initiate_download(mux: Mux, crc: bool, size: Option<u32>, capacity: usize, target: &mut impl SdoTarget) -> Started {
+/// Initiate block download. It streams only with its size indicated: the padding of the
+/// last segment is known only from the end request, and the buffer may be too small to hold
+/// that segment back until then.
+pub(super) fn initiate_download<T: SdoTarget>(mux: Mux, crc: bool, size: Option<u32>, capacity: usize, target: &mut T) -> Started {
     let size = size.map(usize::try_from).transpose().map_err(|_| SdoAbort::LengthTooHigh)?;
     target.check_download(mux.index, mux.sub, size)?;
-    if size.is_some_and(|size| size > capacity) {
+    let stream = T::STREAMING && size.is_some() && target.streams(mux.index, mux.sub);
+    if !stream && size.is_some_and(|size| size > capacity) {
         return Err(SdoAbort::OutOfMemory);
     }
-    let blksize = blksize_for(capacity);
-    let download = Download { mux, size, crc, blksize, in_order: 0, skipping: false, received: 0, ended: false };
+    let blksize = blksize_for(if stream { usize::MAX } else { capacity });
+    let download = Download { mux, size, crc, stream, crc_so_far: CRC.start(), blksize, in_order: 0, skipping: false, received: 0, ended: false };
     Ok((State::BlockDownload(download), command::block_download_initiate_frame(mux, blksize)))
 }
 
@@ -89,28 +97,51 @@ impl Download {
     /// of order (a lost or repeated segment) makes the server ignore the rest of the
     /// sub-block and acknowledge the last in-order segment when the sub-block ends, so the
     /// client resends from there.
-    pub(super) fn segment(&mut self, seg: &BlockSegment, buf: &mut [u8], target: &mut impl SdoTarget) -> Result<Step, SdoAbort> {
+    pub(super) fn segment<T: SdoTarget>(&mut self, seg: &BlockSegment, buf: &mut [u8], target: &mut T) -> Result<Step, SdoAbort> {
         if seg.seq == 0 {
             return Err(SdoAbort::InvalidSequence);
         }
+        // A streamed download keeps nothing: sub-blocks are as large as CiA 301 allows.
+        let capacity = if T::STREAMING && self.stream { usize::MAX } else { buf.len() };
         let sub_block_over = seg.last || seg.seq >= self.blksize;
         if self.skipping || seg.seq != self.in_order.saturating_add(1) {
             self.skipping = true;
-            return Ok(Step::Continue(sub_block_over.then(|| self.acknowledge(buf.len()))));
+            return Ok(Step::Continue(sub_block_over.then(|| self.acknowledge(capacity))));
         }
         let start = self.received;
         self.received = start.saturating_add(SEGMENT_DATA);
-        if !seg.last && self.received > buf.len() {
-            return Err(too_long(target, self.mux, self.received));
-        }
-        // The last segment may carry padding past the buffer: only the end request says how much.
-        let fits = buf.len().saturating_sub(start).min(SEGMENT_DATA);
-        if let (Some(dst), Some(src)) = (buf.get_mut(start..start.saturating_add(fits)), seg.data.get(..fits)) {
-            dst.copy_from_slice(src);
+        if T::STREAMING && self.stream {
+            self.stream_segment(seg, start, target)?;
+        } else {
+            if !seg.last && self.received > buf.len() {
+                return Err(too_long(target, self.mux, self.received));
+            }
+            // The last segment may carry padding past the buffer: only the end request says how much.
+            let fits = buf.len().saturating_sub(start).min(SEGMENT_DATA);
+            if let (Some(dst), Some(src)) = (buf.get_mut(start..start.saturating_add(fits)), seg.data.get(..fits)) {
+                dst.copy_from_slice(src);
+            }
         }
         self.in_order = seg.seq;
         self.ended = seg.last;
-        Ok(Step::Continue(sub_block_over.then(|| self.acknowledge(buf.len()))))
+        Ok(Step::Continue(sub_block_over.then(|| self.acknowledge(capacity))))
+    }
+
+    /// An in-order segment of a streamed download, from byte `start`: its bytes up to the
+    /// indicated size go to the target (the rest of the last segment is padding), never as
+    /// the last part: that waits for the end request's length and CRC.
+    fn stream_segment(&mut self, seg: &BlockSegment, start: usize, target: &mut impl SdoTarget) -> Result<(), SdoAbort> {
+        let size = self.size.unwrap_or_default();
+        // Data past the indicated size: a segment that is not the last must be full, and
+        // only an empty value has a segment starting at its size.
+        if !seg.last && self.received > size || start > 0 && start >= size {
+            return Err(SdoAbort::LengthTooHigh);
+        }
+        let data = seg.data.get(..size.saturating_sub(start).min(SEGMENT_DATA)).unwrap_or_default();
+        if self.crc {
+            self.crc_so_far = CRC.update(self.crc_so_far, data);
+        }
+        target.write_part(self.mux.index, self.mux.sub, start, data, false)
     }
 
     /// Acknowledges the in-order segments of the sub-block and announces the next one's size.
@@ -124,19 +155,38 @@ impl Download {
 
     /// The end request: `n` bytes of the last segment carried no data. Checks the length
     /// (buffer, then the indicated size) and the CRC if negotiated, then writes.
-    pub(super) fn end(&self, n: u8, crc: u16, buf: &[u8], target: &mut impl SdoTarget) -> Result<Step, SdoAbort> {
+    pub(super) fn end<T: SdoTarget>(&self, n: u8, crc: u16, buf: &[u8], target: &mut T) -> Result<Step, SdoAbort> {
         let len = self.received.saturating_sub(usize::from(n));
-        let Some(data) = buf.get(..len) else { return Err(too_long(target, self.mux, len)) };
-        match self.size {
-            Some(size) if len > size => return Err(SdoAbort::LengthTooHigh),
-            Some(size) if len < size => return Err(SdoAbort::LengthTooLow),
-            _ => {}
+        if T::STREAMING && self.stream {
+            return self.end_stream(len, crc, target);
         }
+        let Some(data) = buf.get(..len) else { return Err(too_long(target, self.mux, len)) };
+        self.check_size(len)?;
         if self.crc && CRC.checksum(data) != crc {
             return Err(SdoAbort::BlockCrc);
         }
         target.write(self.mux.index, self.mux.sub, data)?;
         Ok(Step::Finish(Some(command::block_download_end_frame())))
+    }
+
+    /// The end of a streamed download of `len` bytes: the same checks on what was handed
+    /// over, then the target's last (empty) part.
+    fn end_stream(&self, len: usize, crc: u16, target: &mut impl SdoTarget) -> Result<Step, SdoAbort> {
+        self.check_size(len)?;
+        if self.crc && CRC.finish(self.crc_so_far) != crc {
+            return Err(SdoAbort::BlockCrc);
+        }
+        target.write_part(self.mux.index, self.mux.sub, len, &[], true)?;
+        Ok(Step::Finish(Some(command::block_download_end_frame())))
+    }
+
+    /// The received length against the indicated size.
+    fn check_size(&self, len: usize) -> Result<(), SdoAbort> {
+        match self.size {
+            Some(size) if len > size => Err(SdoAbort::LengthTooHigh),
+            Some(size) if len < size => Err(SdoAbort::LengthTooLow),
+            _ => Ok(()),
+        }
     }
 }
 

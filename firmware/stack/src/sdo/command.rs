@@ -164,6 +164,14 @@ pub(super) enum Request {
 }
 
 impl Request {
+    /// Whether the request starts a transfer.
+    pub(super) fn initiates(&self) -> bool {
+        matches!(
+            self,
+            Request::InitiateDownload(_) | Request::InitiateUpload { .. } | Request::BlockDownloadInitiate { .. } | Request::BlockUploadInitiate { .. }
+        )
+    }
+
     pub(super) fn parse(frame: &[u8; 8]) -> Request {
         let [b0, i0, i1, sub, d0, d1, d2, d3] = *frame;
         let mux = Mux { index: u16::from_le_bytes([i0, i1]), sub };

@@ -11,7 +11,12 @@
 //!
 //! A download is collected in the server's `N`-byte buffer and written to the target in one
 //! call once complete, so a refused or aborted download changes nothing. An upload reads the
-//! value by offset, a segment at a time, and needs no buffer.
+//! value by offset, a segment at a time, and needs no buffer. A target whose objects are
+//! larger than any buffer it can afford (CANopenIA's 2,217-byte configuration file into
+//! 1F50h.2) may have their downloads *streamed* instead: handed over in parts as they
+//! arrive ([`SdoTarget::streams`], [`SdoTarget::write_part`]), the target voiding them if the
+//! transfer fails ([`SdoTarget::abort_stream`]). The code for it is in the image only if
+//! [`SdoTarget::STREAMING`] says so.
 //!
 //! Choices where CiA 301 leaves room, so a client can rely on them:
 //!
@@ -59,6 +64,29 @@
 //! - **Timeout**: a transfer with no client frame for the timeout (elapsed >= timeout; 1 s
 //!   by default) is aborted by `poll` with `Timeout` (0504 0000h). While the server sends a
 //!   block upload sub-block it is not waiting, so each segment sent restarts the clock.
+//!
+//! Streamed downloads (CiA 301 does not know them: what the client sees is unchanged, only
+//! the limits differ):
+//!
+//! - **Which**: the target is asked at each segmented or block download initiation, after
+//!   its own checks; the size indicated is still checked against the object's maximum
+//!   (`check_download`), but a size beyond the buffer is no longer `OutOfMemory`.
+//! - **Expedited downloads** of a streaming object are written whole, as before: the data is
+//!   in the frame, so there is nothing to stream, and the target keeps a single path for
+//!   every value that arrives whole (host and device writes too).
+//! - **Segmented download**: each segment is a part, handed over once its toggle and length
+//!   checks pass; the last segment is the last part, after the `LengthTooLow` check.
+//! - **Block download** streams only with its size indicated (without, it is collected in
+//!   the buffer as before): the last segment's padding is known only from the end request,
+//!   and a buffer of a few bytes cannot hold that segment back. In-order segments become
+//!   parts once received (a resent segment never twice: only in-order ones are taken), the
+//!   last one cut at the indicated size; the CRC is accumulated over the parts. The end
+//!   request checks the length and the CRC, then hands over an empty last part. Sub-blocks
+//!   are 127 segments, as no buffer limits them.
+//! - **Failure**: every way a streamed download ends without its last part accepted (abort
+//!   from either side, timeout, toggle, length or CRC error, a refused part, NMT reset or
+//!   stop through [`SdoServer::reset`], a new initiate) calls `abort_stream` exactly once;
+//!   for a new initiate, before the target is asked anything about the new transfer.
 
 mod block;
 pub mod client;
@@ -91,6 +119,30 @@ pub trait SdoTarget {
     fn fixed_size(&mut self, _index: u16, _sub: u8) -> Option<usize> {
         None
     }
+
+    /// Whether any download may stream (below). If not, the constant being false, the
+    /// streaming code is not in the image.
+    const STREAMING: bool = false;
+
+    /// Whether a segmented or block download of `index`/`sub`, just initiated and checked,
+    /// is handed over in parts ([`SdoTarget::write_part`]) instead of collected in the
+    /// server's buffer. Asked only if [`SdoTarget::STREAMING`].
+    fn streams(&mut self, _index: u16, _sub: u8) -> bool {
+        false
+    }
+
+    /// The next part of a streamed download: `data` belongs at byte `offset` of the value;
+    /// parts come in order without gaps. `last`: the download is complete and checked (the
+    /// last part may be empty). An error aborts the transfer with that code.
+    fn write_part(&mut self, _index: u16, _sub: u8, _offset: usize, _data: &[u8], _last: bool) -> Result<(), SdoAbort> {
+        Err(SdoAbort::UnsupportedAccess)
+    }
+
+    /// A streamed download ended without success (abort from either side, timeout, NMT
+    /// reset or stop, a new initiate, an error of `write_part` itself): what its parts wrote
+    /// is void. Called exactly once for every streamed download that does not end with
+    /// `write_part(.., last = true)` succeeding.
+    fn abort_stream(&mut self, _index: u16, _sub: u8) {}
 }
 
 /// The default SDO timeout: 1 s.
@@ -107,6 +159,15 @@ enum State {
 }
 
 impl State {
+    /// The object of a streamed download in progress.
+    fn streamed(&self) -> Option<Mux> {
+        match self {
+            State::Download(t) if t.stream => Some(t.mux),
+            State::BlockDownload(t) if t.stream => Some(t.mux),
+            _ => None,
+        }
+    }
+
     /// The object of the transfer in progress.
     fn mux(&self) -> Option<Mux> {
         match self {
@@ -141,7 +202,7 @@ fn too_long(target: &mut impl SdoTarget, mux: Mux, len: usize) -> SdoAbort {
 }
 
 /// A CiA 301 SDO server with an `N`-byte download buffer (the largest value a client can
-/// write with a segmented or block download).
+/// write with a segmented or block download, streamed downloads aside).
 #[derive(Debug)]
 pub struct SdoServer<const N: usize> {
     state: State,
@@ -175,9 +236,10 @@ impl<const N: usize> SdoServer<N> {
         matches!(self.state, State::Idle)
     }
 
-    /// Drops any transfer silently (NMT reset or stop): nothing is written or sent.
-    pub fn reset(&mut self) {
-        self.state = State::Idle;
+    /// Drops any transfer silently (NMT reset or stop): nothing is written or sent; the
+    /// target of a streamed download hears of it ([`SdoTarget::abort_stream`]).
+    pub fn reset<T: SdoTarget>(&mut self, target: &mut T) {
+        self.drop_transfer(target);
     }
 
     /// A received request (the payload of a CAN frame on COB-ID 600h + node ID). Returns the
@@ -192,60 +254,65 @@ impl<const N: usize> SdoServer<N> {
         {
             let mux = down.mux;
             let step = down.segment(&BlockSegment::parse(&frame), &mut self.buf, target);
-            return self.step(mux, step);
+            return self.step(mux, step, target);
         }
         let current = self.state.mux();
-        match (Request::parse(&frame), &mut self.state) {
+        let request = Request::parse(&frame);
+        // A streamed download that a new initiate replaces ends before the new one asks.
+        if T::STREAMING && request.initiates() {
+            self.drop_transfer(target);
+        }
+        match (request, &mut self.state) {
             (Request::Abort, _) => {
-                self.state = State::Idle;
+                self.drop_transfer(target);
                 None
             }
             (Request::InitiateDownload(init), _) => {
                 let started = segmented::initiate_download(&init, N, target);
-                self.start(init.mux, started)
+                self.start(init.mux, started, target)
             }
             (Request::InitiateUpload { mux }, _) => {
                 let started = segmented::initiate_upload(mux, target);
-                self.start(mux, started)
+                self.start(mux, started, target)
             }
             (Request::BlockDownloadInitiate { mux, .. } | Request::BlockUploadInitiate { mux, .. }, _) if !T::BLOCK_TRANSFER => {
-                self.abort(current.unwrap_or(mux), SdoAbort::UnknownCommand)
+                self.abort(current.unwrap_or(mux), SdoAbort::UnknownCommand, target)
             }
             (Request::BlockDownloadInitiate { mux, crc, size }, _) => {
                 let started = block::initiate_download(mux, crc, size, N, target);
-                self.start(mux, started)
+                self.start(mux, started, target)
             }
             (Request::BlockUploadInitiate { mux, crc, blksize, pst }, _) => {
                 let started = block::initiate_upload(mux, crc, blksize, pst, target);
-                self.start(mux, started)
+                self.start(mux, started, target)
             }
             (Request::DownloadSegment(seg), State::Download(down)) => {
                 let (mux, step) = (down.mux, down.segment(&seg, &mut self.buf, target));
-                self.step(mux, step)
+                self.step(mux, step, target)
             }
             (Request::UploadSegment { toggle }, State::Upload(up)) => {
                 let (mux, step) = (up.mux, up.segment(toggle, target));
-                self.step(mux, step)
+                self.step(mux, step, target)
             }
             (Request::BlockDownloadEnd { n, crc }, State::BlockDownload(down)) if T::BLOCK_TRANSFER => {
                 let (mux, step) = (down.mux, down.end(n, crc, &self.buf, target));
-                self.step(mux, step)
+                self.step(mux, step, target)
             }
             (Request::BlockUploadStart, State::BlockUpload(up)) if T::BLOCK_TRANSFER => {
                 let (mux, step) = (up.mux, up.start());
-                self.step(mux, step)
+                self.step(mux, step, target)
             }
             (Request::BlockUploadAck { ackseq, blksize }, State::BlockUpload(up)) if T::BLOCK_TRANSFER => {
                 let (mux, step) = (up.mux, up.ack(ackseq, blksize));
-                self.step(mux, step)
+                self.step(mux, step, target)
             }
             (Request::BlockUploadEnd, State::BlockUpload(up)) if T::BLOCK_TRANSFER => {
                 let (mux, step) = (up.mux, up.end());
-                self.step(mux, step)
+                self.step(mux, step, target)
             }
-            (Request::Unknown { mux }, _) => self.abort(current.unwrap_or(mux), SdoAbort::UnknownCommand),
+            (Request::Unknown { mux }, _) => self.abort(current.unwrap_or(mux), SdoAbort::UnknownCommand, target),
             // A segment or block sub-command that does not belong to the transfer in progress.
-            _ => self.abort(current.unwrap_or_default(), SdoAbort::UnknownCommand),
+            _ => self.abort(current.unwrap_or_default(), SdoAbort::UnknownCommand, target),
         }
     }
 
@@ -262,39 +329,63 @@ impl<const N: usize> SdoServer<N> {
                     return Some(frame);
                 }
                 Ok(None) => {}
-                Err(code) => return self.abort(mux, code),
+                Err(code) => return self.abort(mux, code, target),
             }
         }
         if now_us.saturating_sub(self.last_us) >= self.timeout_us {
-            return self.abort(mux, SdoAbort::Timeout);
+            return self.abort(mux, SdoAbort::Timeout, target);
         }
         None
     }
 
-    fn start(&mut self, mux: Mux, started: Started) -> Option<[u8; 8]> {
+    fn start<T: SdoTarget>(&mut self, mux: Mux, started: Started, target: &mut T) -> Option<[u8; 8]> {
         match started {
             Ok((state, response)) => {
                 self.state = state;
                 Some(response)
             }
-            Err(code) => self.abort(mux, code),
+            Err(code) => self.abort(mux, code, target),
         }
     }
 
-    fn step(&mut self, mux: Mux, step: Result<Step, SdoAbort>) -> Option<[u8; 8]> {
+    fn step<T: SdoTarget>(&mut self, mux: Mux, step: Result<Step, SdoAbort>, target: &mut T) -> Option<[u8; 8]> {
         match step {
             Ok(Step::Continue(response)) => response,
             Ok(Step::Finish(response)) => {
                 self.state = State::Idle;
                 response
             }
-            Err(code) => self.abort(mux, code),
+            Err(code) => self.abort(mux, code, target),
         }
     }
 
-    /// Ends the transfer with an abort frame.
-    fn abort(&mut self, mux: Mux, code: SdoAbort) -> Option<[u8; 8]> {
+    /// Ends the transfer with an abort frame, telling a streamed download's target. Inlined:
+    /// without streaming it is the plain `send_abort`, as before streaming existed.
+    #[inline(always)]
+    fn abort<T: SdoTarget>(&mut self, mux: Mux, code: SdoAbort, target: &mut T) -> Option<[u8; 8]> {
+        self.end_stream(target);
+        self.send_abort(mux, code)
+    }
+
+    fn send_abort(&mut self, mux: Mux, code: SdoAbort) -> Option<[u8; 8]> {
         self.state = State::Idle;
         Some(command::abort_frame(mux, code))
+    }
+
+    /// Ends the transfer in progress without success (nothing is sent).
+    fn drop_transfer<T: SdoTarget>(&mut self, target: &mut T) {
+        self.end_stream(target);
+        self.state = State::Idle;
+    }
+
+    /// The one place a streamed download's target hears that it failed: called as any
+    /// transfer ends without success, it tells a streamed download's target once.
+    fn end_stream<T: SdoTarget>(&mut self, target: &mut T) {
+        if T::STREAMING
+            && let Some(mux) = self.state.streamed()
+        {
+            self.state = State::Idle;
+            target.abort_stream(mux.index, mux.sub);
+        }
     }
 }

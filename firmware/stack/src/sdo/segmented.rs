@@ -5,12 +5,14 @@ use super::{SdoTarget, Started, State, Step, too_long};
 use crate::od::{ReadLen, SdoAbort};
 
 /// A segmented download in progress; the value collects in the server's buffer and reaches
-/// the target only after the last segment.
+/// the target only after the last segment, unless it streams.
 #[derive(Debug)]
 pub(super) struct Download {
     pub(super) mux: Mux,
     /// The toggle bit the next segment must carry (the first carries 0).
     toggle: bool,
+    /// Each segment goes to the target at once ([`SdoTarget::write_part`]), not to the buffer.
+    pub(super) stream: bool,
     /// The size the client indicated, if it did.
     size: Option<usize>,
     /// Bytes received so far.
@@ -22,7 +24,7 @@ pub(super) struct Download {
 /// Expedited with `s = 0` carries "an unspecified number of bytes": the entry's own size if
 /// it has a fixed one of at most 4 bytes, otherwise all four bytes, and the dictionary's
 /// length check decides.
-pub(super) fn initiate_download(init: &InitDownload, capacity: usize, target: &mut impl SdoTarget) -> Started {
+pub(super) fn initiate_download<T: SdoTarget>(init: &InitDownload, capacity: usize, target: &mut T) -> Started {
     let mux = init.mux;
     if init.expedited {
         let len = if init.sized { 4 - usize::from(init.n) } else { target.fixed_size(mux.index, mux.sub).filter(|&n| n <= 4).unwrap_or(4) };
@@ -33,24 +35,28 @@ pub(super) fn initiate_download(init: &InitDownload, capacity: usize, target: &m
     }
     let size = if init.sized { Some(usize::try_from(u32::from_le_bytes(init.data)).map_err(|_| SdoAbort::LengthTooHigh)?) } else { None };
     target.check_download(mux.index, mux.sub, size)?;
+    let stream = T::STREAMING && target.streams(mux.index, mux.sub);
     // The dictionary would take it, but the buffer cannot hold it.
-    if size.is_some_and(|size| size > capacity) {
+    if !stream && size.is_some_and(|size| size > capacity) {
         return Err(SdoAbort::OutOfMemory);
     }
-    Ok((State::Download(Download { mux, toggle: false, size, len: 0 }), command::download_initiate_frame(mux)))
+    Ok((State::Download(Download { mux, toggle: false, stream, size, len: 0 }), command::download_initiate_frame(mux)))
 }
 
 impl Download {
     /// A download segment. More data than indicated aborts at once (`LengthTooHigh`), less
     /// after the last segment (`LengthTooLow`): the more specific codes rather than the
     /// generic `LengthMismatch`.
-    pub(super) fn segment(&mut self, seg: &Segment, buf: &mut [u8], target: &mut impl SdoTarget) -> Result<Step, SdoAbort> {
+    pub(super) fn segment<T: SdoTarget>(&mut self, seg: &Segment, buf: &mut [u8], target: &mut T) -> Result<Step, SdoAbort> {
         if seg.toggle != self.toggle {
             return Err(SdoAbort::ToggleBit);
         }
         let end = self.len.saturating_add(seg.len());
         if self.size.is_some_and(|size| end > size) {
             return Err(SdoAbort::LengthTooHigh);
+        }
+        if T::STREAMING && self.stream {
+            return self.stream_segment(seg, end, target);
         }
         let Some(dst) = buf.get_mut(self.len..end) else { return Err(too_long(target, self.mux, end)) };
         dst.copy_from_slice(seg.data.get(..seg.len()).unwrap_or_default());
@@ -65,6 +71,19 @@ impl Download {
         }
         target.write(self.mux.index, self.mux.sub, buf.get(..end).unwrap_or_default())?;
         Ok(Step::Finish(Some(response)))
+    }
+
+    /// A segment of a streamed download, ending at `end`: checked as above, then handed to
+    /// the target, the last one with `last` once the length is known to be right.
+    fn stream_segment(&mut self, seg: &Segment, end: usize, target: &mut impl SdoTarget) -> Result<Step, SdoAbort> {
+        if seg.last && self.size.is_some_and(|size| end < size) {
+            return Err(SdoAbort::LengthTooLow);
+        }
+        target.write_part(self.mux.index, self.mux.sub, self.len, seg.data.get(..seg.len()).unwrap_or_default(), seg.last)?;
+        self.len = end;
+        self.toggle = !self.toggle;
+        let response = command::download_segment_frame(seg.toggle);
+        Ok(if seg.last { Step::Finish(Some(response)) } else { Step::Continue(Some(response)) })
     }
 }
 
