@@ -182,3 +182,14 @@ def test_nmt_and_monitor(sim):
     assert "node 4: heartbeat lost" not in events, out
     # Node 2's heartbeat switched off: lost after the consumer time.
     assert "node 2: heartbeat lost" in events[boot:], out
+
+
+def test_sdo_types_from_an_eds(sim, tmp_path):
+    eds = tmp_path / "co401memory1.eds"
+    subprocess.run([COFORGE, "eds", ROOT / "spec" / "co401memory1.yaml", "-o", eds], check=True, capture_output=True)
+    assert master(sim, "sdo", "read", 3, "0x1018", 1, "--eds", eds).stdout.strip() == "88 (0x00000058)"
+    assert master(sim, "sdo", "read", 3, "0x1008", 0, "--eds", eds).stdout.strip() == '"CO401Memory1"'
+    assert "= 250 (0x00FA)" in master(sim, "sdo", "write", 3, "0x1017", 0, "250", "--eds", eds).stdout
+    assert master(sim, "sdo", "read", 3, "0x1017", 0, "--eds", eds).stdout.strip() == "250 (0x00FA)"
+    missing = master(sim, "sdo", "read", 3, "0x2999", 0, "--eds", eds, check=False)
+    assert missing.returncode == 1 and "has no entry 2999h sub 0" in missing.stderr
