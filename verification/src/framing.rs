@@ -24,6 +24,14 @@ pub const CANOPENIA: StartCrcConfig = StartCrcConfig {
     crc_covers_length: true,
     inter_byte_timeout_ms: Some(50),
 };
+/// A pause after which the CANopenIA decoder has resynchronised: longer than its inter-byte
+/// timeout. A constant of its own rather than `CANOPENIA.inter_byte_timeout_ms` in the
+/// property: Kani 0.63's compiler panics on that projection of an `Option` field out of a
+/// constant ("Range is out of bounds", a rustc StableMIR bug).
+pub const IA_RESYNC_PAUSE_MS: Millis = match CANOPENIA.inter_byte_timeout_ms {
+    Some(ms) => ms + 1,
+    None => 1,
+};
 /// Largest GW1 DataLen the decoder buffers in these proofs.
 pub const GW1_MAX: usize = 127;
 pub const IA_MAX: usize = 35;
@@ -162,8 +170,7 @@ pub fn prop_resync_after_garbage(garbage: &[u8], code: u8, data: &[u8]) {
     let mut d = StartCrcDecoder::<IA_MAX>::new(CANOPENIA);
     let t = feed(&mut d, garbage, 0, |_| {});
     if let Ok(n) = start_crc::encode(&CANOPENIA, code, data, &mut buf) {
-        let pause = CANOPENIA.inter_byte_timeout_ms.unwrap_or(0) + 1;
-        expect_last(&mut d, buf.get(..n).unwrap_or(&[]), t.wrapping_add(pause), code, data);
+        expect_last(&mut d, buf.get(..n).unwrap_or(&[]), t.wrapping_add(IA_RESYNC_PAUSE_MS), code, data);
     }
 }
 

@@ -7,6 +7,7 @@
 mod bench;
 mod elf;
 mod images;
+mod kani;
 mod setup;
 mod size;
 mod symbols;
@@ -25,9 +26,10 @@ fn main() -> ExitCode {
         }),
         Some("flash") => images::flash(args.get(1..).unwrap_or_default()),
         Some("bench") => bench::main(args.get(1..).unwrap_or_default()),
+        Some("kani") => kani::main(args.get(1..).unwrap_or_default()),
         _ => {
             eprintln!(
-                "usage: cargo xtask <dist|test|size|flash>\n  dist   check every spec; write EDS files, docs and firmware images into target/dist/\n  test   install missing tools, then run the whole test suite\n  size   flash and RAM of each device's generated code on a Cortex-M0\n         --symbols <device | image.elf> [count]: its largest symbols and flash per module\n  flash  --device <d> --board <b> [--chip <c>]: write an image with probe-rs"
+                "usage: cargo xtask <dist|test|size|flash|bench|kani>\n  dist   check every spec; write EDS files, docs and firmware images into target/dist/\n  test   install missing tools, then run the whole test suite\n  size   flash and RAM of each device's generated code on a Cortex-M0\n         --symbols <device | image.elf> [count]: its largest symbols and flash per module\n  flash  --device <d> --board <b> [--chip <c>]: write an image with probe-rs\n  bench  [--selftest | --instructions | --callgrind]: instruction counts, stack peaks, criterion, sizes\n  kani   [--fast | --all] [--budget-minutes N]: the Kani harnesses, two at a time, as a table"
             );
             return ExitCode::from(2);
         }
@@ -129,27 +131,27 @@ fn test() -> Result {
     setup::rust_components()?;
     let python = setup::python_venv()?;
 
-    println!("xtask: [1/7] formatting and lints");
+    println!("xtask: [1/8] formatting and lints");
     run(cargo().args(["fmt", "--all", "--check"]))?;
     run(cargo().args(["clippy", "--quiet", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
 
-    println!("xtask: [2/7] main outputs build (cargo xtask dist; the image tests read its images)");
+    println!("xtask: [2/8] main outputs build (cargo xtask dist; the image tests read its images)");
     dist()?;
 
-    println!("xtask: [3/7] Rust tests, and the no_std crates for the smallest target");
+    println!("xtask: [3/8] Rust tests, and the no_std crates for the smallest target");
     run(cargo().args(["test", "--workspace"]))?;
     for krate in NO_STD_CRATES {
         run(cargo().args(["build", "--quiet", "--release", "-p", krate, "--target", "thumbv6m-none-eabi"]))?;
     }
 
-    println!("xtask: [4/7] specs: check and canonical formatting");
+    println!("xtask: [4/8] specs: check and canonical formatting");
     run(cargo().args(["build", "--quiet", "-p", "coforge"]))?;
     let coforge = root().join("target/debug/coforge");
     let spec_args: Vec<PathBuf> = specs()?;
     run(Command::new(&coforge).arg("check").args(&spec_args))?;
     run(Command::new(&coforge).args(["fmt", "--check"]).args(&spec_args))?;
 
-    println!("xtask: [5/7] interoperability tests with python-canopen, against the simulator and the QEMU image");
+    println!("xtask: [5/8] interoperability tests with python-canopen, against the simulator and the QEMU image");
     setup::qemu()?;
     // The raw binary `dist` wrote: the tests run exactly what would be flashed.
     let qemu_image = root().join("target/dist/images/co401memory1-qemu.bin");
@@ -168,10 +170,13 @@ fn test() -> Result {
         Some(5) => return Err("pytest collected no tests in tests/python".into()),
         _ => return Err(format!("pytest failed ({status})")),
     }
-    println!("xtask: [6/7] short fuzz runs of every streaming decoder (cargo fuzz)");
+    println!("xtask: [6/8] short fuzz runs of every streaming decoder (cargo fuzz)");
     fuzz()?;
 
-    println!("xtask: [7/7] size of the generated code on a Cortex-M0");
+    println!("xtask: [7/8] Kani proofs of the fast harnesses, if this machine has Kani");
+    kani::ci()?;
+
+    println!("xtask: [8/8] size of the generated code on a Cortex-M0");
     size::report()?;
 
     println!("xtask: all tests passed");

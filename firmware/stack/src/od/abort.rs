@@ -77,8 +77,44 @@ impl SdoAbort {
         self as u32
     }
 
-    pub fn from_code(code: u32) -> Option<SdoAbort> {
-        SdoAbort::ALL.into_iter().find(|a| a.code() == code)
+    /// The abort of a code; `None` for a code CiA 301 does not list. A `match`, not a search
+    /// of [`ALL`](Self::ALL): no loop for a model checker to unwind (Kani needed a bound of
+    /// 32 for the search).
+    pub const fn from_code(code: u32) -> Option<SdoAbort> {
+        Some(match code {
+            0x0503_0000 => SdoAbort::ToggleBit,
+            0x0504_0000 => SdoAbort::Timeout,
+            0x0504_0001 => SdoAbort::UnknownCommand,
+            0x0504_0002 => SdoAbort::InvalidBlockSize,
+            0x0504_0003 => SdoAbort::InvalidSequence,
+            0x0504_0004 => SdoAbort::BlockCrc,
+            0x0504_0005 => SdoAbort::OutOfMemory,
+            0x0601_0000 => SdoAbort::UnsupportedAccess,
+            0x0601_0001 => SdoAbort::WriteOnly,
+            0x0601_0002 => SdoAbort::ReadOnly,
+            0x0602_0000 => SdoAbort::NoObject,
+            0x0604_0041 => SdoAbort::NotMappable,
+            0x0604_0042 => SdoAbort::PdoTooLong,
+            0x0604_0043 => SdoAbort::IncompatibleParameter,
+            0x0604_0047 => SdoAbort::IncompatibleInternal,
+            0x0606_0000 => SdoAbort::Hardware,
+            0x0607_0010 => SdoAbort::LengthMismatch,
+            0x0607_0012 => SdoAbort::LengthTooHigh,
+            0x0607_0013 => SdoAbort::LengthTooLow,
+            0x0609_0011 => SdoAbort::NoSubIndex,
+            0x0609_0030 => SdoAbort::InvalidValue,
+            0x0609_0031 => SdoAbort::ValueTooHigh,
+            0x0609_0032 => SdoAbort::ValueTooLow,
+            0x0609_0036 => SdoAbort::MaxBelowMin,
+            0x060A_0023 => SdoAbort::NoResource,
+            0x0800_0000 => SdoAbort::General,
+            0x0800_0020 => SdoAbort::DataTransfer,
+            0x0800_0021 => SdoAbort::DataTransferLocal,
+            0x0800_0022 => SdoAbort::DataTransferState,
+            0x0800_0023 => SdoAbort::NoDictionary,
+            0x0800_0024 => SdoAbort::NoData,
+            _ => return None,
+        })
     }
 
     /// The meaning CiA 301 (table 22) gives the code, for people reading an abort.

@@ -1,0 +1,237 @@
+//! `cargo xtask kani [--fast | --all] [--budget-minutes N]`: the Kani harnesses of
+//! `verification/`, two at a time, each with a time limit, as a table (result, time, peak
+//! memory); and what `cargo xtask test` runs: the fast set, when this machine has Kani.
+//!
+//! Kani is not on any registry this project's machines reach, so a machine may lack it. Then
+//! nothing fails and nothing passes silently: the run says how many harnesses Kani did not
+//! run, and that their properties ran as exhaustive and random tests.
+
+use crate::{Result, root};
+use std::os::unix::process::CommandExt as _;
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The Kani version the harnesses were verified with here (`.github/workflows/kani.yml` pins
+/// the same).
+pub const KANI_VERSION: &str = "0.63.0";
+
+/// Harnesses that verify within a few minutes on a 2-core machine: every push runs them.
+/// The rest (the mirrored-bank harnesses) run nightly or on demand.
+pub const FAST: &[&str] = &[
+    "harnesses::crc_table_step_equals_bitwise",
+    "harnesses::crc_equals_reference_up_to_4_bytes",
+    "harnesses::crc_detects_bursts_up_to_16_bits_in_4_bytes",
+    "harnesses::sum32_update_step",
+    "harnesses::nibble_round_trip",
+    "harnesses::length_byte_round_trip_up_to_8_bytes",
+    "harnesses::start_crc_round_trip_up_to_6_bytes",
+    "harnesses::decoders_are_total_for_8_bytes",
+    "harnesses::resync_after_4_bytes_of_garbage",
+    "harnesses::nmt_commands_address_only_this_node",
+    "harnesses::sdo_first_request_answers_validly",
+];
+
+/// Longest a single harness may run in `--all` (the issue's limit for the bank harnesses).
+const ALL_LIMIT: Duration = Duration::from_secs(30 * 60);
+/// Longest a fast harness may run before it counts as a failure.
+const FAST_LIMIT: Duration = Duration::from_secs(10 * 60);
+/// What `cargo xtask test` gives the fast set, unless `KANI_BUDGET_MINUTES` says otherwise.
+const CI_BUDGET_MINUTES: u64 = 20;
+
+/// How a harness ended.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Outcome {
+    Verified,
+    Failed,
+    /// Stopped at its time limit.
+    Timeout,
+    /// Not started: the budget was spent.
+    NotRun,
+    /// Kani itself failed (no verification result).
+    Error(String),
+}
+
+struct Run {
+    name: String,
+    outcome: Outcome,
+    secs: f64,
+    peak_kb: Option<u64>,
+}
+
+/// Whether `cargo kani` runs here.
+pub fn installed() -> bool {
+    Command::new("cargo").args(["kani", "--version"]).stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok_and(|s| s.success())
+}
+
+/// The harnesses of `verification/src`, by counting their `#[kani::proof]` attributes (what
+/// the workflow checks too).
+fn harness_count() -> usize {
+    let dir = root().join("verification/src");
+    std::fs::read_dir(&dir)
+        .map(|entries| entries.filter_map(|e| std::fs::read_to_string(e.ok()?.path()).ok()).map(|text| text.matches("#[kani::proof]").count()).sum())
+        .unwrap_or(0)
+}
+
+/// Every harness's qualified name, from `cargo kani list`.
+fn all_harnesses() -> Result<Vec<String>> {
+    let dir = root().join("verification");
+    crate::run(Command::new("cargo").args(["kani", "list", "--format", "json"]).current_dir(&dir))?;
+    let text = std::fs::read_to_string(dir.join("kani-list.json")).map_err(|e| format!("cannot read kani-list.json: {e}"))?;
+    // `"standard-harnesses": {"file": ["harnesses::a", ...]}`: the names are the quoted
+    // strings that contain `::`.
+    let section = text.split("\"standard-harnesses\"").nth(1).and_then(|s| s.split('}').next()).ok_or("kani-list.json has no standard-harnesses")?;
+    Ok(section.split('"').filter(|s| s.contains("::")).map(str::to_string).collect())
+}
+
+/// `cargo xtask test`'s Kani step.
+pub fn ci() -> Result {
+    if !installed() {
+        println!(
+            "xtask: Kani not installed: {} harnesses not run by Kani; their properties ran as exhaustive/random tests (see verification/README.md)",
+            harness_count()
+        );
+        return Ok(());
+    }
+    let minutes = std::env::var("KANI_BUDGET_MINUTES").ok().and_then(|m| m.parse().ok()).unwrap_or(CI_BUDGET_MINUTES);
+    let names: Vec<String> = FAST.iter().map(|s| s.to_string()).collect();
+    let runs = run_all(&names, FAST_LIMIT, Duration::from_secs(minutes * 60))?;
+    report(&runs, harness_count())
+}
+
+/// `cargo xtask kani [--fast | --all] [--budget-minutes N]`.
+pub fn main(args: &[String]) -> Result {
+    if !installed() {
+        return Err(format!("Kani is not installed: `cargo kani --version` fails (the harnesses were verified with Kani {KANI_VERSION})"));
+    }
+    let mut all = false;
+    let mut budget = Duration::from_secs(24 * 3600);
+    let mut rest = args.iter();
+    while let Some(arg) = rest.next() {
+        match arg.as_str() {
+            "--all" => all = true,
+            "--fast" => all = false,
+            "--budget-minutes" => {
+                let m: u64 = rest.next().and_then(|m| m.parse().ok()).ok_or("--budget-minutes takes a number")?;
+                budget = Duration::from_secs(m * 60);
+            }
+            other => return Err(format!("unknown argument `{other}`; usage: cargo xtask kani [--fast | --all] [--budget-minutes N]")),
+        }
+    }
+    let names = if all { all_harnesses()? } else { FAST.iter().map(|s| s.to_string()).collect() };
+    let runs = run_all(&names, if all { ALL_LIMIT } else { FAST_LIMIT }, budget)?;
+    report(&runs, harness_count())
+}
+
+/// Prints the table; fails unless every harness that ran was verified.
+fn report(runs: &[Run], total: usize) -> Result {
+    println!("| harness | Kani result | time | peak memory |\n|---|---|---:|---:|");
+    for r in runs {
+        let outcome = match &r.outcome {
+            Outcome::Verified => "VERIFIED".to_string(),
+            Outcome::Failed => "**FAILED**".to_string(),
+            Outcome::Timeout => "**timeout**".to_string(),
+            Outcome::NotRun => "not run (budget spent)".to_string(),
+            Outcome::Error(e) => format!("**error**: {e}"),
+        };
+        let mem = r.peak_kb.map_or("—".to_string(), |kb| format!("{} MB", kb / 1024));
+        println!("| `{}` | {outcome} | {:.1} s | {mem} |", r.name, r.secs);
+    }
+    let verified = runs.iter().filter(|r| r.outcome == Outcome::Verified).count();
+    let not_run = runs.iter().filter(|r| r.outcome == Outcome::NotRun).count();
+    println!(
+        "xtask: Kani {KANI_VERSION}: {verified} of {} harnesses run here VERIFIED, {not_run} not run for the budget; {} of the {total} harnesses are in the slow set (`cargo xtask kani --all`)",
+        runs.len(),
+        total.saturating_sub(FAST.len())
+    );
+    let bad: Vec<&str> = runs.iter().filter(|r| !matches!(r.outcome, Outcome::Verified | Outcome::NotRun)).map(|r| r.name.as_str()).collect();
+    if bad.is_empty() { Ok(()) } else { Err(format!("Kani did not verify: {}", bad.join(", "))) }
+}
+
+/// A running harness.
+struct Job {
+    name: String,
+    child: Child,
+    started: Instant,
+    log: PathBuf,
+    time_file: PathBuf,
+}
+
+/// Runs `names` two at a time (each worker with a target directory of its own: two `cargo
+/// kani` in one directory race on its goto files), each within `limit`, none started after
+/// `budget` has passed.
+fn run_all(names: &[String], limit: Duration, budget: Duration) -> Result<Vec<Run>> {
+    let out = root().join("target/kani-runs");
+    std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let began = Instant::now();
+    let mut queue = names.iter();
+    let mut workers: [Option<Job>; 2] = [None, None];
+    let mut runs = Vec::new();
+    let time = std::path::Path::new("/usr/bin/time").exists();
+    loop {
+        for (w, slot) in workers.iter_mut().enumerate() {
+            if let Some(job) = slot {
+                let elapsed = job.started.elapsed();
+                let done = job.child.try_wait().map_err(|e| e.to_string())?.is_some();
+                if !done && elapsed < limit {
+                    continue;
+                }
+                if !done {
+                    // The whole group: cargo, kani and the cbmc underneath.
+                    let _ = Command::new("kill").args(["-KILL", "--", &format!("-{}", job.child.id())]).status();
+                    let _ = job.child.wait();
+                }
+                runs.push(finish(job, done));
+                *slot = None;
+            }
+            if slot.is_none()
+                && let Some(name) = queue.next()
+            {
+                if began.elapsed() >= budget {
+                    runs.push(Run { name: name.clone(), outcome: Outcome::NotRun, secs: 0.0, peak_kb: None });
+                    continue;
+                }
+                let safe = name.replace("::", "-");
+                let log = out.join(format!("{safe}.log"));
+                let time_file = out.join(format!("{safe}.time"));
+                let mut cmd = if time { Command::new("/usr/bin/time") } else { Command::new("cargo") };
+                if time {
+                    cmd.args(["-f", "%M", "-o"]).arg(&time_file).arg("cargo");
+                }
+                cmd.args(["kani", "--harness", name, "--exact", "--target-dir"])
+                    .arg(root().join(format!("target/kani-w{w}")))
+                    .current_dir(root().join("verification"))
+                    .process_group(0);
+                let file = std::fs::File::create(&log).map_err(|e| format!("cannot create {}: {e}", log.display()))?;
+                let err = file.try_clone().map_err(|e| e.to_string())?;
+                let child = cmd.stdout(file).stderr(err).spawn().map_err(|e| format!("cannot run cargo kani: {e}"))?;
+                println!("xtask: kani {name}");
+                *slot = Some(Job { name: name.clone(), child, started: Instant::now(), log, time_file });
+            }
+        }
+        if workers.iter().all(Option::is_none) && queue.len() == 0 {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    // In the order asked.
+    runs.sort_by_key(|r| names.iter().position(|n| *n == r.name));
+    Ok(runs)
+}
+
+fn finish(job: &Job, done: bool) -> Run {
+    let secs = job.started.elapsed().as_secs_f64();
+    let log = std::fs::read_to_string(&job.log).unwrap_or_default();
+    let peak_kb = std::fs::read_to_string(&job.time_file).ok().and_then(|t| t.lines().last()?.trim().parse().ok());
+    let outcome = if !done {
+        Outcome::Timeout
+    } else if log.contains("VERIFICATION:- SUCCESSFUL") {
+        Outcome::Verified
+    } else if log.contains("VERIFICATION:- FAILED") {
+        Outcome::Failed
+    } else {
+        let last = log.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("no output").trim().to_string();
+        Outcome::Error(format!("{last} (log: {})", job.log.display()))
+    };
+    Run { name: job.name.clone(), outcome, secs, peak_kb }
+}
