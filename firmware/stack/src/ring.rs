@@ -52,6 +52,14 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         self.buf.get(at).copied()
     }
 
+    /// Appends `value`, dropping the oldest value if the ring is full: for queues whose reader
+    /// may never come, where the newest matter most. Whether one was dropped.
+    pub(crate) fn push_back_evicting(&mut self, value: T) -> bool {
+        let evicted = self.is_full() && self.pop_front().is_some();
+        let _ = self.push_back(value);
+        evicted
+    }
+
     pub(crate) fn clear(&mut self) {
         self.head = 0;
         self.len = 0;
@@ -96,6 +104,15 @@ mod tests {
         assert_eq!(r.pop_front(), None);
         assert_eq!(r.push_back(4), Ok(()));
         assert_eq!(r.pop_front(), Some(4));
+    }
+
+    #[test]
+    fn a_full_ring_keeps_the_newest_when_asked() {
+        let mut r: Ring<u8, 2> = Ring::new(0);
+        assert!(!r.push_back_evicting(1));
+        assert!(!r.push_back_evicting(2));
+        assert!(r.push_back_evicting(3), "1 dropped");
+        assert_eq!((r.pop_front(), r.pop_front(), r.pop_front()), (Some(2), Some(3), None));
     }
 
     #[test]

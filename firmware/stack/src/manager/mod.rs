@@ -278,11 +278,9 @@ impl<const NODES: usize, const PDOS: usize> Manager<NODES, PDOS> {
     }
 
     fn event(&mut self, event: ManagerEvent) {
-        if self.events.is_full() {
-            self.events.pop_front();
+        if self.events.push_back_evicting(event) {
             self.events_dropped = self.events_dropped.saturating_add(1);
         }
-        let _ = self.events.push_back(event);
     }
 
     fn send(&mut self, frame: CanFrame) -> bool {

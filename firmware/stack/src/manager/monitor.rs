@@ -18,6 +18,7 @@
 //!   active from an error until an error reset with an error register of 0.
 
 use crate::frame::CanFrame;
+use crate::nmt::{self, NmtState};
 
 /// How many nodes a network has.
 pub const NODES: usize = 127;
@@ -38,12 +39,14 @@ pub enum NodeState {
 impl NodeState {
     /// The state of a boot-up or heartbeat byte; `None` if it is neither.
     pub const fn of_code(code: u8) -> Option<NodeState> {
-        Some(match code & 0x7F {
-            0x00 => NodeState::BootUp,
-            0x04 => NodeState::Stopped,
-            0x05 => NodeState::Operational,
-            0x7F => NodeState::PreOperational,
-            _ => return None,
+        if code & 0x7F == 0 {
+            return Some(NodeState::BootUp);
+        }
+        Some(match nmt::state_of_code(code) {
+            Some(NmtState::Stopped) => NodeState::Stopped,
+            Some(NmtState::Operational) => NodeState::Operational,
+            Some(NmtState::PreOperational) => NodeState::PreOperational,
+            None => return None,
         })
     }
 }
@@ -228,8 +231,10 @@ impl Monitor {
 
     /// The next heartbeat found lost at `now_us`; call until `None`.
     pub fn check(&mut self, now_us: u64) -> Option<MonitorEvent> {
+        // Most polls: nothing monitored, or nothing due yet.
+        let due = self.next_due_ms?;
         let now_ms = ms(now_us);
-        if !self.next_due_ms.is_some_and(|due| reached(now_ms, due)) {
+        if !reached(now_ms, due) {
             return None;
         }
         let mut next: Option<u32> = None;

@@ -11,6 +11,7 @@
 //! recorded up to the last entry read, and a refused 1017h write is ignored. A node that does
 //! not answer, or refuses 1000h or 1018h.1 (which CiA 301 makes mandatory), aborts its scan.
 
+use crate::node::le_u32;
 use crate::sdo::client::{AbortSource, SdoResult};
 use heapless::Vec;
 
@@ -268,10 +269,6 @@ const fn comm_index(dir: Dir, n: u8) -> u16 {
     }
 }
 
-fn le_u32(bytes: &[u8]) -> u32 {
-    bytes.iter().take(4).rev().fold(0, |acc, &b| acc << 8 | u32::from(b))
-}
-
 /// Scans queued nodes one at a time and caches up to `NODES` completed records.
 #[derive(Debug, Clone)]
 pub struct Scanner<const NODES: usize, const PDOS: usize> {
@@ -306,11 +303,6 @@ impl<const NODES: usize, const PDOS: usize> Scanner<NODES, PDOS> {
     pub fn knows(&self, node: u8) -> bool {
         let bit = if node < 128 { 1 << node } else { 0 };
         (self.pending | self.done) & bit != 0 || self.current.as_ref().is_some_and(|s| s.node() == node)
-    }
-
-    /// Whether a scan is running.
-    pub fn is_scanning(&self) -> bool {
-        self.current.is_some()
     }
 
     /// Starts the scan of the lowest queued node if none is running.

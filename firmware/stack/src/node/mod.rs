@@ -240,7 +240,7 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
         if !self.core.can_enabled {
             return;
         }
-        let sdo_rx = 0x600 + u16::from(self.core.node_id);
+        let sdo_rx = crate::sdo::request_id(self.core.node_id);
         if frame.id == sdo_rx && !frame.rtr {
             if nmt::allows_sdo(self.core.state)
                 && let Some(response) = self.sdo.on_request(frame.payload(), now_us, &mut self.core)
@@ -441,15 +441,12 @@ impl<D: NodeDictionary, S: ParamStore, const P: usize> Core<D, S, P> {
     }
 
     fn send_sdo(&mut self, payload: [u8; 8]) {
-        self.send(0x580 + u16::from(self.node_id), &payload);
+        self.send(crate::sdo::response_id(self.node_id), &payload);
     }
 
     fn event(&mut self, e: NodeEvent) {
         // Device code that never drains events must not stop the node: oldest go first.
-        if self.events.is_full() {
-            self.events.pop_front();
-        }
-        let _ = self.events.push_back(e);
+        self.events.push_back_evicting(e);
     }
 
     fn set_state(&mut self, state: NmtState) {

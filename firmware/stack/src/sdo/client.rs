@@ -33,20 +33,12 @@
 //! - **Block transfer** is not offered: a client that needs it for speed uses segmented
 //!   transfer, which every server supports.
 
+pub use super::{request_id, response_id};
+
 use super::DEFAULT_TIMEOUT_US;
 use super::command::{self, Mux, Response, SEGMENT_DATA, Segment};
 use crate::frame::CanFrame;
 use crate::od::SdoAbort;
-
-/// The COB-ID a node's default SDO server receives on.
-pub const fn request_id(node: u8) -> u16 {
-    0x600 + node as u16
-}
-
-/// The COB-ID a node's default SDO server answers on.
-pub const fn response_id(node: u8) -> u16 {
-    0x580 + node as u16
-}
 
 /// Which side ended a transfer with an abort.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -145,6 +145,16 @@ pub trait SdoTarget {
     fn abort_stream(&mut self, _index: u16, _sub: u8) {}
 }
 
+/// The COB-ID a node's default SDO server receives on (CiA 301 predefined connection set).
+pub const fn request_id(node: u8) -> u16 {
+    0x600 + node as u16
+}
+
+/// The COB-ID a node's default SDO server answers on.
+pub const fn response_id(node: u8) -> u16 {
+    0x580 + node as u16
+}
+
 /// The default SDO timeout: 1 s.
 pub const DEFAULT_TIMEOUT_US: u64 = 1_000_000;
 
