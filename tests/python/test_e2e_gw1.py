@@ -141,6 +141,10 @@ class Target(Sim):
             self.node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
             self.net.add_node(self.node)
             self.host = Host(self.sim.serial_url)
+            # QEMU starts the image under load slowly: until it runs its loop, the bytes of a
+            # telegram may come further apart than the chip's 10 ms and be dropped. The chip
+            # says it is ready with its first boot-up telegram.
+            assert self.host.wait_bootup(5.0), f"no boot-up telegram from the image{self.sim.output_note()}"
         except BaseException:
             self.close()
             raise

@@ -29,6 +29,7 @@ QEMU_IMAGE = os.environ.get("COFORGE_QEMU_IMAGE", str(ROOT / "firmware/boards/qe
 # The image that keeps its banks in host files (semihosting), beside the plain one.
 FILES_IMAGE = str(pathlib.Path(QEMU_IMAGE).resolve().with_name(pathlib.Path(QEMU_IMAGE).name.replace("co401memory1", "co401memory1-files", 1)))
 NODE_ID = 5  # the QEMU board's ID pins; the simulator derives its pins from --node-id
+SDO_TIMEOUT = 2.0
 WAIT = 10.0
 
 
@@ -100,13 +101,32 @@ def target(request):
     try:
         net.connect(interface="slcan", channel=t.can_url, sleep_after_open=0, bitrate=1000000)
         node = canopen.RemoteNode(NODE_ID, canopen.ObjectDictionary())
-        node.sdo.RESPONSE_TIMEOUT = 2.0
+        node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
         net.add_node(node)
         t.net, t.node, t.rec = net, node, rec
+        if t.kind == "qemu":
+            wait_serving(t)
         yield t
     finally:
         net.disconnect()
         t.close()
+
+
+def wait_serving(t, timeout=20.0):
+    """Waits until the image answers an SDO read of 1000h, as a master waits for a node that
+    is starting: QEMU starts an image slowly on a busy machine, and the node's boot-up went
+    out before anyone listened."""
+    deadline = time.monotonic() + timeout
+    t.node.sdo.RESPONSE_TIMEOUT = 0.5
+    try:
+        while True:
+            try:
+                t.node.sdo.upload(0x1000, 0)
+                return
+            except canopen.SdoCommunicationError:
+                assert time.monotonic() < deadline, f"the image did not answer SDO within {timeout} s"
+    finally:
+        t.node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
 
 
 def upload(t, index, sub=0):
@@ -122,7 +142,11 @@ def exchange(t, request_hex, answer_len):
     got = b""
     deadline = time.monotonic() + WAIT
     while len(got) < answer_len and time.monotonic() < deadline:
-        got += t.serial.recv(answer_len - len(got))
+        # The socket's own timeout (2 s) only bounds one wait: a busy machine may take longer.
+        try:
+            got += t.serial.recv(answer_len - len(got))
+        except TimeoutError:
+            continue
     return got.hex(" ").upper()
 
 

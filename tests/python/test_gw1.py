@@ -124,6 +124,16 @@ class Host(SerialLine):
         assert len(data) == n, f"telegram cut short: {(head + data).hex(' ')}"
         return head + data
 
+    def wait_bootup(self, timeout=WAIT):
+        """Waits for a boot-up telegram of the boot phase, as a host does before it talks to
+        a chip that is starting (a starting chip may miss bytes); False if none came."""
+        t = self.telegram(timeout)
+        if t is None:
+            return False
+        assert t == BOOTUP, f"unexpected telegram in the boot phase: {X(t)}"
+        self.bootups.append(time.monotonic())
+        return True
+
     def answer(self, timeout=WAIT):
         """The next telegram that is not a boot-up telegram of the boot phase, or None."""
         deadline = time.monotonic() + timeout

@@ -382,7 +382,11 @@ fn read_loop(mut stream: TcpStream, bus: &Bus, node: u64, role: Role, replies: &
             Err(err) if err.kind() == io::ErrorKind::Interrupted => continue,
             Err(_) => break,
         };
-        decoder.push(buf.get(..n).unwrap_or_default());
+        let bytes = buf.get(..n).unwrap_or_default();
+        match role {
+            Role::Host => decoder.push_from_adapter(bytes),
+            Role::Adapter => decoder.push(bytes),
+        }
         for cmd in decoder.by_ref() {
             if let Command::Frame(frame) = cmd {
                 bus.route(node, frame);

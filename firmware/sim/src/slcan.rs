@@ -30,6 +30,12 @@ impl Decoder {
         self.ready.extend(bytes.iter().filter_map(|&b| self.lines.push(b)));
     }
 
+    /// As [`push`](Decoder::push), for a host reading an adapter's output (see
+    /// [`coforge_slcan::Decoder::push_from_adapter`]).
+    pub fn push_from_adapter(&mut self, bytes: &[u8]) {
+        self.ready.extend(bytes.iter().filter_map(|&b| self.lines.push_from_adapter(b)));
+    }
+
     /// Bytes of an unfinished line held back (0 while discarding an over-long line).
     pub fn partial_len(&self) -> usize {
         self.lines.partial_len()

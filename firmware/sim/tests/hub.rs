@@ -433,6 +433,10 @@ fn the_hub_connects_to_an_slcan_adapter_as_its_host() {
     line.write_all(b"z\rt58580000000000000000\r").expect("socket");
     let frame = port.recv_timeout(WAIT).expect("the adapter's frame on the hub");
     assert_eq!(frame, data(0x585, &[0; 8]));
+    // An error answer (a lone BELL: a line reached the adapter garbled) does not swallow the
+    // frame line after it.
+    line.write_all(b"\x07t705100\r").expect("socket");
+    assert_eq!(port.recv_timeout(WAIT), Some(data(0x705, &[0])), "the frame after an error answer");
     line.set_read_timeout(Some(QUIET)).expect("socket");
     let mut answer = [0_u8; 8];
     assert!(matches!(line.read(&mut answer), Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut)), "the host answers nothing");

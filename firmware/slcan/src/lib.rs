@@ -114,6 +114,9 @@ pub fn encode(frame: &CanFrame, out: &mut [u8; MAX_FRAME_LINE]) -> usize {
     n
 }
 
+/// The Lawicel error answer, sent alone (no `\r` follows).
+pub const BELL: u8 = 0x07;
+
 /// The Lawicel answer to a command: `\r` for OK, BELL (`\x07`) for an error, `z\r` / `Z\r`
 /// for a transmitted standard / extended frame, `V1013\r`, `NC0F0\r` and `F00\r` (no error
 /// flags) for the queries.
@@ -125,7 +128,7 @@ pub fn reply(cmd: &Command) -> &'static [u8] {
         Command::Version => b"V1013\r",
         Command::SerialNumber => b"NC0F0\r",
         Command::Status => b"F00\r",
-        Command::Invalid => b"\x07",
+        Command::Invalid => &[BELL],
     }
 }
 
@@ -169,6 +172,14 @@ impl Decoder {
             self.discarding = true;
             Some(Command::Invalid)
         }
+    }
+
+    /// As [`push`](Decoder::push), for a host reading what an adapter sends: its error
+    /// answer, a lone [`BELL`] without `\r`, ends a line too (python-can reads answers so).
+    /// Otherwise the frame line that follows an error answer would be taken as one line
+    /// with it, and lost as invalid.
+    pub fn push_from_adapter(&mut self, byte: u8) -> Option<Command> {
+        self.push(if byte == BELL { b'\r' } else { byte })
     }
 
     /// Bytes of an unfinished line held back (0 while discarding an over-long line).
@@ -250,6 +261,20 @@ fn hex(digits: &[u8]) -> Option<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_error_answer_ends_a_line_only_for_the_adapters_host() {
+        // An adapter answered a garbled line with BELL, then sent a frame.
+        let output = b"\x07t705100\r";
+        let frame = CanFrame::data(0x705, &[0]).unwrap();
+        let mut host = Decoder::new();
+        let got: heapless::Vec<Command, 2> = output.iter().filter_map(|&b| host.push_from_adapter(b)).collect();
+        assert_eq!(got.as_slice(), [Command::Frame(frame)]);
+        // A device reading its host's commands takes BELL as a character of the line.
+        let mut device = Decoder::new();
+        let got: heapless::Vec<Command, 2> = output.iter().filter_map(|&b| device.push(b)).collect();
+        assert_eq!(got.as_slice(), [Command::Invalid]);
+    }
 
     #[test]
     fn encodes_lines_that_parse_back() {

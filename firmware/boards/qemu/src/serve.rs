@@ -19,7 +19,7 @@ pub fn serve<D: Device>(device: &mut D) -> ! {
 pub fn serve_with<D: Device>(device: &mut D, mut hook: impl FnMut(&mut D, u64)) -> ! {
     let Some(core) = cortex_m::Peripherals::take() else { panic!("peripherals taken twice") };
     clock::start(core.SYST);
-    let (host, can) = (Uart::new(UART0), Uart::new(UART1));
+    let (mut host, mut can) = (Uart::new(UART0), Uart::new(UART1));
     device.start(0);
     let mut lines = slcan::Decoder::new();
     let mut line = [0_u8; slcan::MAX_FRAME_LINE];

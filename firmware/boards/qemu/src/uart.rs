@@ -21,6 +21,8 @@ const LCRH_WLEN_8: u32 = 0b11 << 5;
 #[derive(Debug)]
 pub struct Uart {
     base: usize,
+    /// A byte that arrived before [`Uart::new`] switched the FIFO on (see there).
+    early: Option<u8>,
 }
 
 impl Uart {
@@ -29,8 +31,15 @@ impl Uart {
     /// without it QEMU hands over the next byte only after the data register was read, and a
     /// busy host can stretch the gap between two bytes of a telegram past a protocol's
     /// inter-byte timeout (CO401GW1's 10 ms).
+    ///
+    /// QEMU empties the receive buffer when the FIFO is switched on or off. A host may connect
+    /// and send while the image is still starting (mounting its banks from host files takes a
+    /// while): the first byte then waits in the one-byte holding register (the next ones wait
+    /// in QEMU, since the register is full), and is taken out here before the switch instead
+    /// of being lost.
     pub fn new(base: usize) -> Uart {
-        let uart = Uart { base };
+        let mut uart = Uart { base, early: None };
+        uart.early = uart.take_waiting();
         uart.write_reg(LCRH, LCRH_WLEN_8 | LCRH_FEN);
         uart.write_reg(CTL, 0x301);
         uart
@@ -48,7 +57,11 @@ impl Uart {
     }
 
     /// A received byte, if one is waiting.
-    pub fn read(&self) -> Option<u8> {
+    pub fn read(&mut self) -> Option<u8> {
+        self.early.take().or_else(|| self.take_waiting())
+    }
+
+    fn take_waiting(&self) -> Option<u8> {
         (self.read_reg(FR) & FR_RXFE == 0).then(|| self.read_reg(DR) as u8)
     }
 
