@@ -2,6 +2,7 @@
 //! command and encodes back to the same bytes, and `decode(encode(x)) == x` for every command
 //! a frame can carry (random frames, all devices).
 
+use coforge_link::properties::{Direction as LinkDirection, prop_decoder_total, prop_round_trip};
 use coforge_link::{Deframer, EncodeError, Frame, Message, SerialCodec};
 use coforge_spec::model::Direction;
 use proptest::prelude::*;
@@ -61,25 +62,41 @@ fn reencode<'a, M: Message<'a>>(frame: &Frame<'a>, name: &str, bytes: &[u8], out
 }
 
 /// `decode(encode(x)) == x` for whatever command of either direction a frame of `code`,
-/// `length_code` and `data` carries.
-fn decode_encode_identity<C: SerialCodec>(code: u8, length_code: Option<u8>, data: &[u8]) -> Result<(), TestCaseError> {
-    let frame = Frame { code, length_code, network: None, data };
-    let (mut to_device, mut to_host) = (Vec::new(), Vec::new());
-    identity::<C, C::HostToDevice<'_>>(&frame, &mut to_device)?;
-    identity::<C, C::DeviceToHost<'_>>(&frame, &mut to_host)
+/// `length_code` and `data` carries: the property the generated Kani harnesses prove
+/// (`coforge_link::properties`), here on random frames.
+fn decode_encode_identity<C: SerialCodec>(code: u8, length_code: Option<u8>, data: &[u8]) {
+    let (mut out, mut copy) = ([0_u8; 1024], [0_u8; 1024]);
+    for direction in [LinkDirection::HostToDevice, LinkDirection::DeviceToHost] {
+        prop_round_trip::<C>(direction, code, length_code, data, &mut out, &mut copy);
+    }
 }
 
-/// The identity for one direction; the re-deframed data goes to `scratch`, which lives as long
-/// as the frame's data, so both decodings have the same type.
-fn identity<'a, C: SerialCodec, M: Message<'a>>(frame: &Frame<'a>, scratch: &'a mut Vec<u8>) -> Result<(), TestCaseError> {
-    let Ok(x) = M::decode(frame) else { return Ok(()) };
-    let mut out = [0_u8; 300];
-    let len = x.encode(&mut out).expect("a decoded command encodes");
-    let (code, length_code, data) = deframe(&mut C::decoder(), &out[..len]).expect("an encoded frame deframes");
-    *scratch = data;
-    let data: &'a [u8] = scratch;
-    prop_assert_eq!(M::decode(&Frame { code, length_code, network: None, data }), Ok(x));
-    Ok(())
+/// Every command of `spec_name`, each of its codes, `runs` random data of every length the
+/// generated harness of the command tries (and up to 40 bytes of a longer tail): the
+/// generated harnesses' inputs, drawn at random.
+fn every_command_round_trips<C: SerialCodec>(spec_name: &str, runs: usize) {
+    let d = spec(spec_name);
+    let mut rng = proptest::test_runner::TestRng::deterministic_rng(proptest::test_runner::RngAlgorithm::ChaCha);
+    let (mut out, mut copy) = ([0_u8; 1024], [0_u8; 1024]);
+    let mut checked = 0;
+    for cmd in &d.serial.as_ref().expect("serial").commands {
+        let direction = match cmd.direction {
+            Direction::HostToDevice => LinkDirection::HostToDevice,
+            Direction::DeviceToHost => LinkDirection::DeviceToHost,
+        };
+        let harness_max = coforge_codegen::serial_proofs::harness_data_len(cmd);
+        let max = harness_max.max(cmd.length.1.min(40));
+        for code in cmd.codes() {
+            for len in cmd.length.0.min(harness_max)..=max {
+                for _ in 0..runs {
+                    let data: Vec<u8> = (0..len).map(|_| rng.next_u32() as u8).collect();
+                    prop_round_trip::<C>(direction, code as u8, cmd.length_code.map(|x| x as u8), &data, &mut out, &mut copy);
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked > 0, "{spec_name}: no command checked");
 }
 
 #[test]
@@ -97,20 +114,44 @@ fn canopenia_examples_round_trip() {
     examples_round_trip::<canopenia::serial::Codec>("canopenia.yaml");
 }
 
+#[test]
+fn co401memory1_every_command_round_trips() {
+    every_command_round_trips::<co401memory1::serial::Codec>("co401memory1.yaml", 20);
+}
+
+#[test]
+fn co401gw1_every_command_round_trips() {
+    every_command_round_trips::<co401gw1::serial::Codec>("co401gw1.yaml", 20);
+}
+
+#[test]
+fn canopenia_every_command_round_trips() {
+    every_command_round_trips::<canopenia::serial::Codec>("canopenia.yaml", 20);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 3000, ..ProptestConfig::default() })]
     #[test]
     fn co401memory1_decode_encode_identity(code in any::<u8>(), extension in proptest::option::of(0x80_u8..), data in proptest::collection::vec(any::<u8>(), 0..40)) {
-        decode_encode_identity::<co401memory1::serial::Codec>(code, extension, &data)?;
+        decode_encode_identity::<co401memory1::serial::Codec>(code, extension, &data);
     }
 
     #[test]
     fn co401gw1_decode_encode_identity(code in any::<u8>(), extension in proptest::option::of(0x80_u8..), data in proptest::collection::vec(any::<u8>(), 0..40)) {
-        decode_encode_identity::<co401gw1::serial::Codec>(code, extension, &data)?;
+        decode_encode_identity::<co401gw1::serial::Codec>(code, extension, &data);
     }
 
     #[test]
     fn canopenia_decode_encode_identity(code in any::<u8>(), extension in proptest::option::of(0x80_u8..), data in proptest::collection::vec(any::<u8>(), 0..40)) {
-        decode_encode_identity::<canopenia::serial::Codec>(code, extension, &data)?;
+        decode_encode_identity::<canopenia::serial::Codec>(code, extension, &data);
+    }
+
+    /// The generated `decoder_total` harnesses' property on random bytes and gaps.
+    #[test]
+    fn generated_decoders_are_total(bytes in proptest::collection::vec(any::<u8>(), 0..200), gaps in proptest::collection::vec(0_u8..60, 0..4)) {
+        let mut out = [0_u8; 1024];
+        prop_decoder_total::<co401memory1::serial::Codec>(&bytes, &gaps, &mut out);
+        prop_decoder_total::<co401gw1::serial::Codec>(&bytes, &gaps, &mut out);
+        prop_decoder_total::<canopenia::serial::Codec>(&bytes, &gaps, &mut out);
     }
 }

@@ -1,5 +1,5 @@
-//! `cargo xtask kani [--fast | --all] [--budget-minutes N]`: the Kani harnesses of
-//! `verification/`, two at a time, each with a time limit, as a table (result, time, peak
+//! `cargo xtask kani [--fast | --all | --list] [--budget-minutes N]`: the Kani harnesses
+//! (`verification/`'s and those the generator emits in each device crate), two at a time, each with a time limit, as a table (result, time, peak
 //! memory); and what `cargo xtask test` runs: the fast set, when this machine has Kani.
 //!
 //! Kani is not on any registry this project's machines reach, so a machine may lack it. Then
@@ -64,20 +64,63 @@ pub fn installed() -> bool {
     Command::new("cargo").args(["kani", "--version"]).stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok_and(|s| s.success())
 }
 
-/// The harnesses of `verification/src`, by counting their `#[kani::proof]` attributes (what
-/// the workflow checks too).
-fn harness_count() -> usize {
+/// The device crates whose generated `serial::proofs` hold Kani harnesses (one per serial
+/// command and one for the decoder), with their specs. A harness of theirs is named
+/// `<crate>/<path>`; a name without a crate is one of `verification/`.
+const DEVICE_CRATES: &[(&str, &str)] = &[("co401memory1", "spec/co401memory1.yaml"), ("co401gw1", "spec/co401gw1.yaml"), ("canopenia", "spec/canopenia.yaml")];
+
+/// The crate directory and the harness path Kani knows of a harness name.
+fn locate(name: &str) -> (PathBuf, &str) {
+    match name.split_once('/') {
+        Some((krate, path)) => (root().join("firmware/devices").join(krate), path),
+        None => (root().join("verification"), name),
+    }
+}
+
+/// The hand-written harnesses of `verification/src`, by counting their `#[kani::proof]`
+/// attributes (what the workflow checks too).
+fn handwritten_count() -> usize {
     let dir = root().join("verification/src");
     std::fs::read_dir(&dir)
         .map(|entries| entries.filter_map(|e| std::fs::read_to_string(e.ok()?.path()).ok()).map(|text| text.matches("#[kani::proof]").count()).sum())
         .unwrap_or(0)
 }
 
-/// Every harness's qualified name, from `cargo kani list`.
+/// The harnesses the generator emits for `spec`: one per serial command, one for the decoder.
+fn generated_count(spec: &str) -> Result<usize> {
+    let text = std::fs::read_to_string(root().join(spec)).map_err(|e| format!("cannot read {spec}: {e}"))?;
+    let device = coforge_spec::load_str(spec, &text).into_device().ok_or(format!("{spec} does not load: run `coforge check {spec}`"))?;
+    Ok(device.serial.map_or(0, |s| s.commands.len() + 1))
+}
+
+/// Every harness, hand-written and generated.
+fn harness_count() -> usize {
+    handwritten_count() + DEVICE_CRATES.iter().filter_map(|(_, spec)| generated_count(spec).ok()).sum::<usize>()
+}
+
+/// Every harness's name, from `cargo kani list` in each crate; fails when a crate's list
+/// does not hold what its sources say (a harness Kani does not see is never run).
 fn all_harnesses() -> Result<Vec<String>> {
-    let dir = root().join("verification");
-    crate::run(Command::new("cargo").args(["kani", "list", "--format", "json"]).current_dir(&dir))?;
-    let text = std::fs::read_to_string(dir.join("kani-list.json")).map_err(|e| format!("cannot read kani-list.json: {e}"))?;
+    let mut names = list(&root().join("verification"))?;
+    if names.len() != handwritten_count() {
+        return Err(format!("Kani lists {} harnesses in verification/, its sources have {} `#[kani::proof]`", names.len(), handwritten_count()));
+    }
+    for (krate, spec) in DEVICE_CRATES {
+        let found = list(&root().join("firmware/devices").join(krate))?;
+        let expected = generated_count(spec)?;
+        if found.len() != expected {
+            return Err(format!("Kani lists {} harnesses in {krate}, the generator emits {expected} for {spec}", found.len()));
+        }
+        names.extend(found.into_iter().map(|n| format!("{krate}/{n}")));
+    }
+    Ok(names)
+}
+
+/// The harnesses Kani lists in the crate at `dir`.
+fn list(dir: &std::path::Path) -> Result<Vec<String>> {
+    crate::run(Command::new("cargo").args(["kani", "list", "--format", "json"]).current_dir(dir))?;
+    let file = dir.join("kani-list.json");
+    let text = std::fs::read_to_string(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
     harness_names(&text)
 }
 
@@ -104,7 +147,7 @@ pub fn ci() -> Result {
     report(&runs, harness_count())
 }
 
-/// `cargo xtask kani [--fast | --all] [--budget-minutes N]`.
+/// `cargo xtask kani [--fast | --all | --list] [--budget-minutes N]`.
 pub fn main(args: &[String]) -> Result {
     if !installed() {
         return Err(format!("Kani is not installed: `cargo kani --version` fails (the harnesses were verified with Kani {KANI_VERSION})"));
@@ -116,11 +159,17 @@ pub fn main(args: &[String]) -> Result {
         match arg.as_str() {
             "--all" => all = true,
             "--fast" => all = false,
+            "--list" => {
+                let names = all_harnesses()?;
+                names.iter().for_each(|n| println!("{n}"));
+                println!("xtask: {} harnesses: {} hand-written, {} generated", names.len(), handwritten_count(), names.len() - handwritten_count());
+                return Ok(());
+            }
             "--budget-minutes" => {
                 let m: u64 = rest.next().and_then(|m| m.parse().ok()).ok_or("--budget-minutes takes a number")?;
                 budget = Duration::from_secs(m * 60);
             }
-            other => return Err(format!("unknown argument `{other}`; usage: cargo xtask kani [--fast | --all] [--budget-minutes N]")),
+            other => return Err(format!("unknown argument `{other}`; usage: cargo xtask kani [--fast | --all | --list] [--budget-minutes N]")),
         }
     }
     let names = if all { all_harnesses()? } else { FAST.iter().map(|s| s.to_string()).collect() };
@@ -196,16 +245,17 @@ fn run_all(names: &[String], limit: Duration, budget: Duration) -> Result<Vec<Ru
                     runs.push(Run { name: name.clone(), outcome: Outcome::NotRun, secs: 0.0, peak_kb: None });
                     continue;
                 }
-                let safe = name.replace("::", "-");
+                let safe = name.replace("::", "-").replace('/', "-");
                 let log = out.join(format!("{safe}.log"));
                 let time_file = out.join(format!("{safe}.time"));
                 let mut cmd = if time { Command::new("/usr/bin/time") } else { Command::new("cargo") };
                 if time {
                     cmd.args(["-f", "%M", "-o"]).arg(&time_file).arg("cargo");
                 }
-                cmd.args(["kani", "--harness", name, "--exact", "--target-dir"])
+                let (dir, path) = locate(name);
+                cmd.args(["kani", "--harness", path, "--exact", "--target-dir"])
                     .arg(root().join(format!("target/kani-w{w}")))
-                    .current_dir(root().join("verification"))
+                    .current_dir(dir)
                     .process_group(0);
                 let file = std::fs::File::create(&log).map_err(|e| format!("cannot create {}: {e}", log.display()))?;
                 let err = file.try_clone().map_err(|e| e.to_string())?;
@@ -251,5 +301,21 @@ mod tests {
         assert_eq!(harness_names(json), Ok(vec!["harnesses::a".to_string(), "harnesses::m::b".to_string(), "c".to_string()]));
         assert!(harness_names("{}").is_err());
         assert!(FAST.iter().all(|h| h.starts_with("harnesses::")));
+    }
+
+    #[test]
+    fn a_generated_harness_runs_in_its_device_crate() {
+        let (dir, path) = locate("co401gw1/serial::proofs::decoder_total");
+        assert_eq!((dir, path), (root().join("firmware/devices/co401gw1"), "serial::proofs::decoder_total"));
+        let (dir, path) = locate("harnesses::nibble_round_trip");
+        assert_eq!((dir, path), (root().join("verification"), "harnesses::nibble_round_trip"));
+    }
+
+    #[test]
+    fn the_generator_emits_a_harness_per_command_and_one_per_decoder() {
+        // CO401Memory1 has 14 serial commands, CO401GW1 16, CANopenIA 9 (`coforge check`).
+        let counts: Vec<usize> = DEVICE_CRATES.iter().map(|(_, spec)| generated_count(spec).expect("spec loads")).collect();
+        assert_eq!(counts, [15, 17, 10]);
+        assert_eq!(harness_count(), handwritten_count() + 42);
     }
 }

@@ -30,6 +30,7 @@ mod modes;
 mod naming;
 mod pdos;
 mod serial;
+pub mod serial_proofs;
 
 use coforge_spec::Device;
 use proc_macro2::{Literal, Span, TokenStream};

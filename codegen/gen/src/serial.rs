@@ -321,6 +321,7 @@ pub fn serial_module(d: &Device, _options: &Options) -> TokenStream {
         [direction_enum(&to_device, &Ident::new("HostToDevice", Span::call_site())), direction_enum(&to_host, &Ident::new("DeviceToHost", Span::call_site()))];
     let (to_device_lt, to_host_lt) = (lifetime(&to_device), lifetime(&to_host));
     let max = crate::dec(max_data as u64);
+    let proofs = crate::serial_proofs::proofs_module(serial);
     quote! {
         /// The serial protocol: framing, decoder and typed commands, generated from the spec.
         pub mod serial {
@@ -354,6 +355,8 @@ pub fn serial_module(d: &Device, _options: &Options) -> TokenStream {
                     decoder()
                 }
             }
+
+            #proofs
         }
     }
 }

@@ -18,6 +18,7 @@ pub mod crc;
 pub mod fields;
 pub mod length_byte;
 pub mod nibble;
+pub mod properties;
 pub mod start_crc;
 
 /// Milliseconds from a free-running clock. It may wrap; only differences are used.
