@@ -1,4 +1,4 @@
-//! `cargo xtask kani [--fast | --all | --list] [--budget-minutes N]`: the Kani harnesses
+//! `cargo xtask kani [--fast | --all | --list] [--filter PART] [--budget-minutes N]`: the Kani harnesses
 //! (`verification/`'s and those the generator emits in each device crate), two at a time, each with a time limit, as a table (result, time, peak
 //! memory); and what `cargo xtask test` runs: the fast set, when this machine has Kani.
 //!
@@ -147,12 +147,13 @@ pub fn ci() -> Result {
     report(&runs, harness_count())
 }
 
-/// `cargo xtask kani [--fast | --all | --list] [--budget-minutes N]`.
+/// `cargo xtask kani [--fast | --all | --list] [--filter PART] [--budget-minutes N]`.
 pub fn main(args: &[String]) -> Result {
     if !installed() {
         return Err(format!("Kani is not installed: `cargo kani --version` fails (the harnesses were verified with Kani {KANI_VERSION})"));
     }
     let mut all = false;
+    let mut filter: Option<String> = None;
     let mut budget = Duration::from_secs(24 * 3600);
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
@@ -165,14 +166,21 @@ pub fn main(args: &[String]) -> Result {
                 println!("xtask: {} harnesses: {} hand-written, {} generated", names.len(), handwritten_count(), names.len() - handwritten_count());
                 return Ok(());
             }
+            "--filter" => filter = Some(rest.next().ok_or("--filter takes a part of a harness name")?.clone()),
             "--budget-minutes" => {
                 let m: u64 = rest.next().and_then(|m| m.parse().ok()).ok_or("--budget-minutes takes a number")?;
                 budget = Duration::from_secs(m * 60);
             }
-            other => return Err(format!("unknown argument `{other}`; usage: cargo xtask kani [--fast | --all | --list] [--budget-minutes N]")),
+            other => return Err(format!("unknown argument `{other}`; usage: cargo xtask kani [--fast | --all | --list] [--filter PART] [--budget-minutes N]")),
         }
     }
-    let names = if all { all_harnesses()? } else { FAST.iter().map(|s| s.to_string()).collect() };
+    let mut names: Vec<String> = if all { all_harnesses()? } else { FAST.iter().map(|s| s.to_string()).collect() };
+    if let Some(part) = &filter {
+        names.retain(|n| n.contains(part.as_str()));
+        if names.is_empty() {
+            return Err(format!("no harness name contains `{part}` (`cargo xtask kani --list` lists them)"));
+        }
+    }
     let runs = run_all(&names, if all { ALL_LIMIT } else { FAST_LIMIT }, budget)?;
     report(&runs, harness_count())
 }

@@ -29,7 +29,7 @@ fn main() -> ExitCode {
         Some("kani") => kani::main(args.get(1..).unwrap_or_default()),
         _ => {
             eprintln!(
-                "usage: cargo xtask <dist|test|size|flash|bench|kani>\n  dist   check every spec; write EDS files, docs and firmware images into target/dist/\n  test   install missing tools, then run the whole test suite\n  size   flash and RAM of each device's generated code on a Cortex-M0\n         --symbols <device | image.elf> [count]: its largest symbols and flash per module\n  flash  --device <d> --board <b> [--chip <c>]: write an image with probe-rs\n  bench  [--selftest | --instructions | --callgrind]: instruction counts, stack peaks, criterion, sizes\n  kani   [--fast | --all] [--budget-minutes N]: the Kani harnesses, two at a time, as a table"
+                "usage: cargo xtask <dist|test|size|flash|bench|kani>\n  dist   check every spec; write EDS files, docs and firmware images into target/dist/\n  test   install missing tools, then run the whole test suite\n  size   flash and RAM of each device's generated code on a Cortex-M0\n         --symbols <device | image.elf> [count]: its largest symbols and flash per module\n  flash  --device <d> --board <b> [--chip <c>]: write an image with probe-rs\n  bench  [--selftest | --instructions | --callgrind]: instruction counts, stack peaks, criterion, sizes\n  kani   [--fast | --all | --list] [--filter PART] [--budget-minutes N]: the Kani harnesses (hand-written and generated), two at a time, as a table"
             );
             return ExitCode::from(2);
         }
