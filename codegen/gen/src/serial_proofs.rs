@@ -83,12 +83,14 @@ fn round_trip(c: &Command) -> TokenStream {
 /// The harnesses of `serial`, or nothing for a device without a serial protocol.
 pub fn proofs_module(serial: &Serial) -> TokenStream {
     let harnesses = serial.commands.iter().map(round_trip);
-    let bytes = match serial.framing {
-        Framing::StartLengthCrc { .. } => TOTAL_BYTES_START_CRC,
-        Framing::NibbleLength { .. } | Framing::LengthByte { .. } => TOTAL_BYTES,
+    // The loops run over the pushed bytes and, with a CRC, over a command's frame encoded
+    // again (its data and the framing's bytes).
+    let (bytes, unwind) = match serial.framing {
+        Framing::StartLengthCrc { .. } => (TOTAL_BYTES_START_CRC, TOTAL_BYTES_START_CRC as u32 + OVERHEAD + 2),
+        Framing::NibbleLength { .. } | Framing::LengthByte { .. } => (TOTAL_BYTES, TOTAL_BYTES as u32 + 2),
     };
     let n = crate::dec(bytes as u64);
-    let unwind = crate::dec(bytes as u64 + 2);
+    let unwind = crate::dec(unwind.into());
     let doc = format!(" The decoder takes any {bytes} bytes at any gaps without panicking; every frame it completes decodes and encodes again.");
     quote! {
         /// Kani harnesses over this protocol (`cargo kani`; see verification/README.md).
