@@ -39,7 +39,7 @@ pub fn file_name(d: &Device, mode: Option<&str>) -> String {
 }
 
 /// Objects and entries a CAN master sees in `mode` (entries with access `none` are hidden).
-fn objects_in<'a>(d: &'a Device, mode: Option<&'a str>) -> impl Iterator<Item = (&'a Object, Vec<&'a Entry>)> + 'a {
+pub(crate) fn objects_in<'a>(d: &'a Device, mode: Option<&'a str>) -> impl Iterator<Item = (&'a Object, Vec<&'a Entry>)> + 'a {
     d.objects
         .iter()
         .filter(move |o| in_mode(&o.modes, mode))

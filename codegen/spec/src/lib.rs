@@ -10,6 +10,7 @@
 //! ```
 #![forbid(unsafe_code)]
 
+pub mod beds;
 pub mod diag;
 pub mod docs;
 pub mod eds;
