@@ -33,6 +33,50 @@ enum Cmd {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Export a spec (or, with --from-eds, a CiA 306 EDS file) as a binary EDS v2.00 file,
+    /// the dictionary configuration CANopenIA loads through 1F50h.2.
+    Beds {
+        /// The spec (YAML), or the EDS file with --from-eds.
+        input: PathBuf,
+        /// The input is an EDS file, not a spec.
+        #[arg(long)]
+        from_eds: bool,
+        /// With --from-eds: apply what CANopenIA's own tool assumes beyond the EDS (5FF5h is
+        /// served by the firmware, the chip ID 5F00h.05 is 12 bytes), so that its files come
+        /// out byte for byte.
+        #[arg(long, requires = "from_eds")]
+        vendor_conventions: bool,
+        /// Operating mode to export (devices with modes).
+        #[arg(long)]
+        mode: Option<String>,
+        /// The node-ID the file configures; values with $NODEID are resolved for it.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=127))]
+        node_id: u8,
+        /// The bit rate the file configures, in kbit/s.
+        #[arg(long, default_value = "125", value_parser = ["10", "20", "50", "125", "250", "500", "800", "1000"])]
+        bitrate: String,
+        /// FUNC bit 0: LSS supported.
+        #[arg(long)]
+        lss: bool,
+        /// FUNC bit 1: start operational without a master.
+        #[arg(long)]
+        autostart: bool,
+        /// FUNC bit 2: boot-up manager (NMT master).
+        #[arg(long)]
+        nmt_master: bool,
+        /// FUNC bit 3: CANopen manager.
+        #[arg(long)]
+        manager: bool,
+        /// FUNC bit 5: node-ID and bit rate come from hardware, not from this file.
+        #[arg(long)]
+        settings_from_hardware: bool,
+        /// The identification string (default: the spec's name and the coforge version; for an
+        /// EDS, what the vendor's tool writes: its file name, modification date and author).
+        #[arg(long)]
+        ident: Option<String>,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Write the Markdown documentation of a spec.
     Docs {
         spec: PathBuf,
@@ -336,6 +380,67 @@ fn run(cmd: Cmd) -> Result<ExitCode, String> {
             let device = loaded.device().ok_or("spec did not load")?;
             let text = coforge_spec::eds::export(device, mode.as_deref()).map_err(|e| e.to_string())?;
             write_output(output.as_deref(), &text)?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Beds {
+            input,
+            from_eds,
+            vendor_conventions,
+            mode,
+            node_id,
+            bitrate,
+            lss,
+            autostart,
+            nmt_master,
+            manager,
+            settings_from_hardware,
+            ident,
+            output,
+        } => {
+            use coforge_beds::layout::func;
+            let flags = [
+                (lss, func::LSS),
+                (autostart, func::AUTOSTART),
+                (nmt_master, func::BOOTUP_MANAGER),
+                (manager, func::MANAGER),
+                (settings_from_hardware, func::SETTINGS_FROM_HARDWARE),
+            ];
+            let func = flags.iter().filter(|(on, _)| *on).fold(0, |acc, (_, bit)| acc | bit);
+            let bitrate_kbit = bitrate.parse().map_err(|_| format!("bad bit rate {bitrate}"))?;
+            let bytes = if from_eds {
+                let text = std::fs::read(&input).map_err(|e| format!("cannot read {}: {e}", input.display()))?;
+                // EDS files are ISO-8859-1: each byte is the character of that code.
+                let text: String = text.iter().map(|&b| char::from(b)).collect();
+                let ident = ident.unwrap_or_else(|| coforge_spec::beds::eds_import::vendor_ident(&text, None));
+                let settings = coforge_spec::beds::Settings { node_id, bitrate_kbit, func, ident };
+                let conventions = if vendor_conventions { coforge_spec::beds::Conventions::canopenia() } else { Default::default() };
+                coforge_spec::beds::export_eds(&text, settings, &conventions)
+            } else {
+                let Some(loaded) = load_reporting(&input) else { return Ok(ExitCode::FAILURE) };
+                let device = loaded.device().ok_or("spec did not load")?;
+                let ident = ident.unwrap_or_else(|| format!("'{}' coforge {}", device.identity.ident, env!("CARGO_PKG_VERSION")));
+                let settings = coforge_spec::beds::Settings { node_id, bitrate_kbit, func, ident };
+                coforge_spec::beds::export(device, mode.as_deref(), settings)
+            }
+            .map_err(|e| e.to_string())?;
+            // Read back with the reader the firmware uses, so a file we write is one it takes.
+            let file = coforge_beds::BinaryEds::parse(&bytes).map_err(|e| format!("internal error: the written file does not read back: {e}"))?;
+            std::fs::write(&output, &bytes).map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+            let h = file.header();
+            eprintln!(
+                "coforge beds: {} ({} bytes): node {}, {} kbit/s, FUNC {:02X}h, {} SDO replies, {} + {} image entries ({} bytes), {} RPDOs, {} TPDOs",
+                output.display(),
+                bytes.len(),
+                h.node_id,
+                h.bitrate_kbit,
+                h.func,
+                file.sdo_replies().count(),
+                file.od_entries().count(),
+                file.generic_entries().count(),
+                h.image_size,
+                h.rpdos,
+                h.tpdos
+            );
             Ok(ExitCode::SUCCESS)
         }
         Cmd::Docs { spec, output } => {

@@ -106,3 +106,49 @@ fn decode_names_the_command_and_its_fields() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("DataLen says 5 data bytes but 1 follow"), "{}", stderr(&o));
 }
+
+#[test]
+fn beds_reproduces_the_vendors_file_from_its_eds() {
+    let out = scratch("io.bin");
+    let eds = "tests/vendor-data/canopenia/CiA401_IO_Node3.eds";
+    // The vendor's tool ran on 02-11-2015; the stamp is not in the EDS, so it is given.
+    let ident = "'CiA401_IO_Node3' 02-11-2015 12:43PM by ESAcademy";
+    let o = coforge(&[
+        "beds",
+        "--from-eds",
+        eds,
+        "--vendor-conventions",
+        "--node-id",
+        "3",
+        "--autostart",
+        "--ident",
+        ident,
+        "-o",
+        out.to_str().expect("utf-8 path"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let ours = std::fs::read(&out).expect("written");
+    let theirs = std::fs::read(repo().join("tests/vendor-data/canopenia/CiA401_IO_Node3.bin")).expect("vendor file");
+    assert!(ours == theirs, "{} bytes against {}", ours.len(), theirs.len());
+    assert!(stderr(&o).contains("96 SDO replies, 108 + 4 image entries (233 bytes), 4 RPDOs, 4 TPDOs"), "{}", stderr(&o));
+}
+
+#[test]
+fn beds_exports_a_spec_and_explains_bad_arguments() {
+    let out = scratch("ia.bin");
+    let o = coforge(&["beds", "spec/canopenia.yaml", "--node-id", "5", "--bitrate", "250", "-o", out.to_str().expect("utf-8 path")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&out).expect("written");
+    let file = coforge_beds::BinaryEds::parse(&bytes).expect("valid");
+    assert_eq!((file.header().node_id, file.header().bitrate_kbit), (5, 250));
+    assert!(file.header().ident.starts_with(b"'canopenia' coforge "));
+    let cases: [(&[&str], &str); 3] = [
+        (&["beds", "spec/co401gw1.yaml", "-o", "x.bin"], "choose one with --mode (mixed, digital, digital_alt)"),
+        (&["beds", "spec/canopenia.yaml", "--node-id", "0", "-o", "x.bin"], "0 is not in 1..=127"),
+        (&["beds", "spec/canopenia.yaml", "--bitrate", "100", "-o", "x.bin"], "invalid value '100'"),
+    ];
+    for (args, needle) in cases {
+        let o = coforge(args);
+        assert!(!o.status.success() && stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+    }
+}

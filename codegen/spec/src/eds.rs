@@ -52,6 +52,13 @@ fn is_dummy(o: &Object) -> bool {
     o.index <= 0x0007
 }
 
+/// Whether the dummy data type `index` (0001h..0007h) is in use in `mode`: the spec declares
+/// it, or a default PDO of this mode maps it.
+pub(crate) fn dummy_in_use(d: &Device, mode: Option<&str>, index: u16) -> bool {
+    let mapped = d.pdo.pdos.iter().filter(|p| in_mode(&p.modes, mode)).any(|p| p.map.iter().any(|m| m.index == index));
+    mapped || objects_in(d, mode).any(|(o, _)| o.index == index)
+}
+
 /// CiA 306 access type: mappable rw entries become `rww` (mapped into an RPDO) or `rwr`
 /// (mapped into a TPDO) according to the default mappings.
 pub fn eds_access(d: &Device, o: &Object, e: &Entry, mode: Option<&str>) -> &'static str {
@@ -150,10 +157,7 @@ pub fn export(d: &Device, mode: Option<&str>) -> Result<String, ExportError> {
     let objects: Vec<_> = objects_in(d, mode).collect();
     let _ = writeln!(out, "[DummyUsage]");
     for i in 1..=7_u16 {
-        // A dummy is in use if the spec declares it or a default PDO of this mode maps it.
-        let mapped = d.pdo.pdos.iter().filter(|p| in_mode(&p.modes, mode)).any(|p| p.map.iter().any(|m| m.index == i));
-        let used = mapped || objects.iter().any(|(o, _)| o.index == i);
-        let _ = writeln!(out, "Dummy{i:04X}={}", u8::from(used));
+        let _ = writeln!(out, "Dummy{i:04X}={}", u8::from(dummy_in_use(d, mode, i)));
     }
     let _ = writeln!(out);
 

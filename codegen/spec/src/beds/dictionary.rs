@@ -2,7 +2,7 @@
 //! resolved for one node-ID, and the header settings. Both a spec ([`Dictionary::from_device`])
 //! and a CiA 306 EDS file ([`super::eds_import`]) lower to this, so one layout pass serves both.
 
-use crate::eds::{ExportError, eds_access, objects_in, resolve_mode};
+use crate::eds::{ExportError, dummy_in_use, eds_access, objects_in, resolve_mode};
 use crate::model::{Device, Value};
 use crate::types::{Access, DataType, ObjectKind};
 
@@ -34,6 +34,27 @@ pub struct Item {
     pub node_relative: bool,
     pub low: Option<Vec<u8>>,
     pub high: Option<Vec<u8>>,
+}
+
+impl Item {
+    /// The dummy data-type entry `index` (0001h..0007h) in use: constant 0 of its type's size.
+    pub fn dummy(index: u16) -> Option<Item> {
+        let data_type = DataType::ALL.into_iter().find(|t| t.code() == index)?;
+        let size = fixed_size(data_type)?;
+        Some(Item {
+            index,
+            sub: 0,
+            kind: ObjectKind::Var,
+            data_type,
+            access: Access::Const,
+            pdo_mapping: true,
+            size,
+            default: Some(vec![0; size]),
+            node_relative: false,
+            low: None,
+            high: None,
+        })
+    }
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -104,6 +125,10 @@ impl Dictionary {
                 });
             }
         }
+        // Dummies a default PDO maps without the spec declaring them, as the EDS lists them.
+        let undeclared: Vec<Item> =
+            (1..=7_u16).filter(|&i| dummy_in_use(d, mode, i) && !items.iter().any(|it| it.index == i)).filter_map(Item::dummy).collect();
+        items.extend(undeclared);
         items.sort_by_key(|i| (i.index, i.sub));
         Ok(Dictionary { settings, items })
     }

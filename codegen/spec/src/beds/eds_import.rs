@@ -73,29 +73,10 @@ fn item(section: &str, p: &Properties, index: u16, sub: u8, kind: ObjectKind, no
     Ok(Item { index, sub, kind, data_type, access, pdo_mapping, size, default, node_relative, low, high })
 }
 
-/// The dummy entries a `[DummyUsage]` section declares: constant, value 0, their type's size.
+/// The dummy entries a `[DummyUsage]` section declares in use.
 fn dummies(ini: &Ini) -> Vec<Item> {
     let Some(usage) = ini.iter().find(|(s, _)| s.is_some_and(|s| s.eq_ignore_ascii_case("DummyUsage"))).map(|(_, p)| p) else { return Vec::new() };
-    (1..=7_u16)
-        .filter(|i| key(usage, &format!("Dummy{i:04X}")).and_then(number) == Some(1))
-        .filter_map(|i| {
-            let data_type = data_type(i)?;
-            let size = fixed_size(data_type)?;
-            Some(Item {
-                index: i,
-                sub: 0,
-                kind: ObjectKind::Var,
-                data_type,
-                access: Access::Const,
-                pdo_mapping: true,
-                size,
-                default: Some(vec![0; size]),
-                node_relative: false,
-                low: None,
-                high: None,
-            })
-        })
-        .collect()
+    (1..=7_u16).filter(|i| key(usage, &format!("Dummy{i:04X}")).and_then(number) == Some(1)).filter_map(Item::dummy).collect()
 }
 
 /// Reads every object section (`[1018]`, `[1018sub3]`) of an EDS; values for `settings.node_id`.

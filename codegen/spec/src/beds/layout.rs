@@ -2,11 +2,11 @@
 //! vendor's tool follows (derived from its files in `tests/vendor-data/canopenia/`, which
 //! this reproduces byte for byte):
 //!
-//! - **SDO replies:** every `const` entry and every entry of the PDO parameter objects
+//! - **SDO replies:** every `const` entry of up to 4 bytes and every entry of the PDO parameter objects
 //!   1400h..1BFFh (communication and mapping), in index order, the value resolved for the
-//!   node-ID. The dummy data types of `[DummyUsage]` come first (they are indices 1..7).
-//! - **Process image:** every other entry, and the PDO communication entries again (they are
-//!   writable at run time). Entries mapped by the default PDOs come first, in mapping order
+//!   node-ID. The dummy data types 0001h..0007h (`[DummyUsage]`) come first, as constants.
+//! - **Process image:** every other entry (a longer constant, such as a device name, read-only),
+//!   and the PDO communication entries again (they are writable at run time). Entries mapped by the default PDOs come first, in mapping order
 //!   (RPDO mappings 1600h.., then TPDO mappings 1A00h..), each PDO's data contiguous, and the
 //!   TPDO block and the rest each starting at a multiple of 4; an entry mapped by several PDOs keeps its first
 //!   place and is listed again. Then the rest in index order, packed without alignment.
@@ -24,7 +24,7 @@
 
 use super::dictionary::{Dictionary, Item};
 use crate::eds::ExportError;
-use crate::types::{Access, DataType};
+use crate::types::Access;
 use coforge_beds::{Dsat, GenericEntry, OdEntry, PdoRecord, SdoReply};
 use std::collections::BTreeMap;
 
@@ -37,6 +37,13 @@ pub struct Conventions {
     /// Sizes of entries whose EDS gives none: CANopenIA's chip ID 5F00h.05 (a DOMAIN) is the
     /// 12-byte unique ID of its microcontroller.
     pub sizes: Vec<((u16, u8), usize)>,
+}
+
+impl Conventions {
+    /// CANopenIA's, as its vendor's tool applies them (`coforge beds --vendor-conventions`).
+    pub fn canopenia() -> Self {
+        Conventions { served_by_firmware: vec![0x5FF5], sizes: vec![((0x5F00, 5), 12)] }
+    }
 }
 
 /// The tables, before they are written out.
@@ -54,6 +61,26 @@ pub struct Tables {
 
 fn is_pdo_parameter(index: u16) -> bool {
     (0x1400..=0x1BFF).contains(&index)
+}
+
+/// The dummy data-type entries 0001h..0007h: constant, whatever a spec declares.
+fn is_data_type(index: u16) -> bool {
+    index <= 0x0007
+}
+
+/// A constant the SDO reply table can hold (longer ones live in the image, read-only).
+fn is_short_constant(item: &Item) -> bool {
+    item.access == Access::Const && (1..=4).contains(&item.size)
+}
+
+/// An entry answered from the SDO reply table.
+fn is_reply(item: &Item) -> bool {
+    is_short_constant(item) || is_pdo_parameter(item.index) || is_data_type(item.index)
+}
+
+/// An entry with a place in the process image.
+fn is_imaged(item: &Item) -> bool {
+    !is_short_constant(item) && !is_data_type(item.index)
 }
 
 fn dsat_flags(access: Access) -> u8 {
@@ -139,15 +166,16 @@ impl Image<'_> {
     }
 }
 
-/// The tables of `dict`. Refuses what the format cannot hold: a constant of more than 4
-/// bytes, an entry of no known size, a default PDO mapping an entry the dictionary lacks.
+/// The tables of `dict`. Refuses what the format cannot hold: a PDO parameter of more than 4
+/// bytes, or a default PDO mapping an entry the dictionary lacks. Entries of no size are
+/// left out.
 pub fn lower(dict: &Dictionary, conventions: &Conventions) -> Result<Tables, ExportError> {
     let mut image = Image { conventions, placed: BTreeMap::new(), end: 0, tables: Tables::default() };
     for item in &dict.items {
-        if item.access == Access::Const || is_pdo_parameter(item.index) {
+        if is_reply(item) {
             let size = image.size_of(item);
             if !(1..=4).contains(&size) {
-                return Err(ExportError(format!("{:04X}h.{:02X}h is a constant of {size} bytes; an SDO reply holds 1 to 4", item.index, item.sub)));
+                return Err(ExportError(format!("{:04X}h.{:02X}h is a PDO parameter of {size} bytes; an SDO reply holds 1 to 4", item.index, item.sub)));
             }
             let value = sized(item.default.as_ref(), 4);
             let data = [value[0], value[1], value[2], value[3]];
@@ -172,7 +200,7 @@ pub fn lower(dict: &Dictionary, conventions: &Conventions) -> Result<Tables, Exp
         }
         image.end = image.end.next_multiple_of(4);
     }
-    for item in dict.items.iter().filter(|i| i.access != Access::Const) {
+    for item in dict.items.iter().filter(|i| is_imaged(i)) {
         if image.placed.contains_key(&(item.index, item.sub)) {
             continue;
         }
@@ -183,10 +211,9 @@ pub fn lower(dict: &Dictionary, conventions: &Conventions) -> Result<Tables, Exp
         }
         let size = image.size_of(item);
         if size == 0 {
-            if item.data_type == DataType::Domain {
-                continue; // served by the firmware: program data, files
-            }
-            return Err(ExportError(format!("{:04X}h.{:02X}h has no size (a string needs a default or a length)", item.index, item.sub)));
+            // No size to reserve: a DOMAIN the firmware serves itself (program data, files),
+            // or a string whose EDS has no default (an EDS cannot say a string's length).
+            continue;
         }
         image.place(item)?;
     }
