@@ -4,9 +4,9 @@
 
 use crate::Options;
 use crate::naming::{camel, ident as field_ident};
-use coforge_spec::model::{Command, Device, Direction, FieldType, Framing, LengthCounts};
+use coforge_spec::model::{Command, Device, Direction, FieldType, Framing, LengthCounts, Serial};
 use proc_macro2::{Ident, Span, TokenStream};
-use quote::quote;
+use quote::{format_ident, quote};
 
 /// The Rust type of a field (tails borrow the frame).
 fn field_type(ty: FieldType) -> TokenStream {
@@ -311,6 +311,29 @@ fn direction_enum(cmds: &[&Command], enum_name: &Ident) -> TokenStream {
     }
 }
 
+/// The bits of the protocol's error-code field, one constant each (none without `error_bits`).
+fn error_bits(serial: &Serial) -> TokenStream {
+    if serial.error_bits.is_empty() {
+        return quote!();
+    }
+    let ty = if serial.error_bits.iter().any(|b| b.bit >= 16) { quote!(u32) } else { quote!(u16) };
+    let bits = serial.error_bits.iter().map(|b| {
+        let name = format_ident!("{}", b.name.to_uppercase());
+        let doc = format!("Bit {}: {}", b.bit, b.description);
+        let bit = crate::dec(u64::from(b.bit));
+        quote! {
+            #[doc = #doc]
+            pub const #name: #ty = 1 << #bit;
+        }
+    });
+    quote! {
+        /// The bits of the error-code field of the answers (the spec's `error_bits`).
+        pub mod errors {
+            #(#bits)*
+        }
+    }
+}
+
 pub fn serial_module(d: &Device, _options: &Options) -> TokenStream {
     let Some(serial) = &d.serial else { return quote!() };
     let max_data = serial.commands.iter().map(|c| c.length.1 as usize).max().unwrap_or(0).max(1);
@@ -322,6 +345,7 @@ pub fn serial_module(d: &Device, _options: &Options) -> TokenStream {
     let (to_device_lt, to_host_lt) = (lifetime(&to_device), lifetime(&to_host));
     let max = crate::dec(max_data as u64);
     let proofs = crate::serial_proofs::proofs_module(serial);
+    let errors = error_bits(serial);
     quote! {
         /// The serial protocol: framing, decoder and typed commands, generated from the spec.
         pub mod serial {
@@ -339,6 +363,8 @@ pub fn serial_module(d: &Device, _options: &Options) -> TokenStream {
             fn put_frame(code: u8, length_code: Option<u8>, data: &[u8], out: &mut [u8]) -> Result<usize, ::coforge_link::EncodeError> {
                 #put
             }
+
+            #errors
 
             #(#dirs)*
 

@@ -83,6 +83,11 @@ impl<const N: usize> Outbox<N> {
     pub fn is_empty(&self) -> bool {
         self.start == self.end
     }
+
+    /// Bytes a frame pushed now may take (all of it once everything was taken).
+    pub fn free(&self) -> usize {
+        if self.is_empty() { N } else { N.saturating_sub(self.end) }
+    }
 }
 
 /// A decoded frame, borrowed from the decoder's buffer until the next byte is pushed.
@@ -176,12 +181,15 @@ mod outbox_tests {
     #[test]
     fn the_outbox_keeps_frames_whole_and_in_order() {
         let mut o = Outbox::<6>::default();
+        assert_eq!(o.free(), 6);
         assert!(o.push_with(|b| b.get_mut(..3).map(|d| d.copy_from_slice(&[1, 2, 3])).map(|()| 3)));
+        assert_eq!(o.free(), 3);
         assert!(!o.push_with(|b| b.get_mut(..4).map(|_| 4)), "no room for 4 more: dropped whole");
         assert_eq!(o.overflows, 1);
         let mut out = [0; 2];
         assert_eq!(o.take(&mut out), 2);
         assert_eq!(out, [1, 2]);
+        assert_eq!(o.free(), 3, "taken bytes come back only once all are taken");
         assert_eq!(o.take(&mut out), 1);
         assert_eq!(out[0], 3);
         assert!(o.is_empty());

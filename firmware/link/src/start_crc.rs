@@ -90,7 +90,33 @@ impl StartCrcConfig {
 
 /// Encodes a frame with the default start byte: `code` is the first payload byte.
 pub fn encode(config: &StartCrcConfig, code: u8, data: &[u8], out: &mut [u8]) -> Result<usize, EncodeError> {
-    let o = config.options(config.start_byte).map_err(|_| EncodeError::CodeOutOfRange)?;
+    encode_with_start(config, config.start_byte, code, data, out)
+}
+
+/// The payload of a frame encoded with the default start byte (as [`encode`] writes it).
+pub fn payload_of<'a>(config: &StartCrcConfig, frame: &'a [u8]) -> Option<&'a [u8]> {
+    let o = config.options(config.start_byte).ok()?;
+    let (&start, rest) = frame.split_first()?;
+    if start != config.start_byte {
+        return None;
+    }
+    let length = rest.get(..usize::from(o.length_bytes))?;
+    let value = length.iter().rev().fold(0_usize, |v, &b| v << 8 | usize::from(b));
+    let len = config.payload_len(o, value)?;
+    rest.get(usize::from(o.length_bytes)..usize::from(o.length_bytes) + len)
+}
+
+/// A frame encoded with the default start byte, written again with the options of `start`
+/// (network, CRC or none, 8- or 16-bit length): how a device answers a command in the form the
+/// command came in.
+pub fn reencode(config: &StartCrcConfig, frame: &[u8], start: u8, out: &mut [u8]) -> Result<usize, EncodeError> {
+    let (&code, data) = payload_of(config, frame).and_then(<[u8]>::split_first).ok_or(EncodeError::CodeOutOfRange)?;
+    encode_with_start(config, start, code, data, out)
+}
+
+/// Encodes a frame with start byte `start` and the options it selects.
+pub fn encode_with_start(config: &StartCrcConfig, start: u8, code: u8, data: &[u8], out: &mut [u8]) -> Result<usize, EncodeError> {
+    let o = config.options(start).map_err(|_| EncodeError::CodeOutOfRange)?;
     let payload = 1 + data.len();
     let max = usize::from(config.max_payload);
     if payload > max {
@@ -110,7 +136,7 @@ pub fn encode(config: &StartCrcConfig, code: u8, data: &[u8], out: &mut [u8]) ->
     for (i, b) in length.iter_mut().enumerate().take(lb) {
         *b = (value >> (8 * i)) as u8;
     }
-    let mut at = put(out, &[config.start_byte])?;
+    let mut at = put(out, &[start])?;
     let length = length.get(..lb).unwrap_or(&[]);
     at += put(out.get_mut(at..).unwrap_or(&mut []), length)?;
     at += put(out.get_mut(at..).unwrap_or(&mut []), &[code])?;
@@ -119,7 +145,7 @@ pub fn encode(config: &StartCrcConfig, code: u8, data: &[u8], out: &mut [u8]) ->
         let crc = config.crc;
         let mut c = crc.start();
         if config.crc_covers_start {
-            c = crc.step(c, config.start_byte);
+            c = crc.step(c, start);
         }
         if config.crc_covers_length {
             c = crc.update(c, length);
@@ -145,6 +171,8 @@ pub struct StartCrcDecoder<const N: usize> {
     config: StartCrcConfig,
     state: State,
     options: Options,
+    /// The start byte of the frame in progress (or last completed).
+    start: u8,
     crc: u16,
     buf: [u8; N],
     filled: usize,
@@ -159,12 +187,18 @@ impl<const N: usize> StartCrcDecoder<N> {
             config,
             state: State::Hunt,
             options: Options { network: None, has_crc: true, length_bytes: 1 },
+            start: config.start_byte,
             crc: 0,
             buf: [0; N],
             filled: 0,
             last: None,
             skipped: 0,
         }
+    }
+
+    /// The start byte of the frame last completed (or in progress): an answer uses its options.
+    pub fn start_byte(&self) -> u8 {
+        self.start
     }
 
     fn payload(&self) -> &[u8] {
@@ -181,6 +215,7 @@ impl<const N: usize> StartCrcDecoder<N> {
         match self.config.options(byte) {
             Ok(o) => {
                 self.options = o;
+                self.start = byte;
                 self.filled = 0;
                 let crc = self.config.crc;
                 self.crc = if self.config.crc_covers_start { crc.step(crc.start(), byte) } else { crc.start() };
@@ -340,5 +375,35 @@ mod tests {
         let n = encode(&IA, b'R', &[0x00, 0x5F, 0x02], &mut out).unwrap_or(0);
         assert_eq!(out[..n], [0x11, 0x04, 0x52, 0x00, 0x5F, 0x02, 0x96, 0x2F]);
         assert_eq!(encode(&IA, b'W', &[0; 35], &mut out), Err(EncodeError::DataTooLong { max: 34 }));
+    }
+
+    #[test]
+    fn an_answer_takes_the_start_byte_of_its_command() {
+        let mut d = StartCrcDecoder::<64>::new(IA);
+        // No CRC, then a 16-bit length on network 2: the decoder remembers each start byte.
+        assert_eq!(feed(&mut d, &[0x01, 0x04, 0x52, 0x00, 0x5F, 0x02]).len(), 1);
+        assert_eq!(d.start_byte(), 0x01);
+        assert_eq!(feed(&mut d, &[0x32, 0x04, 0x00, 0x52, 0x00, 0x5F, 0x02, 0x31, 0xA0]).len(), 1);
+        assert_eq!(d.start_byte(), 0x32);
+        let mut frame = [0; 64];
+        let n = encode(&IA, b'R', &[0x00, 0x5F, 0x02, 0, 0, 7], &mut frame).unwrap_or(0);
+        assert_eq!(payload_of(&IA, &frame[..n]), Some(&[b'R', 0x00, 0x5F, 0x02, 0, 0, 7][..]));
+        let mut out = [0; 64];
+        for (start, want) in [
+            (0x11, &frame[..n]),
+            (0x01, &[0x01, 0x07, b'R', 0x00, 0x5F, 0x02, 0, 0, 7][..]),
+            (0x21, &[0x21, 0x07, 0x00, b'R', 0x00, 0x5F, 0x02, 0, 0, 7][..]),
+        ] {
+            let m = reencode(&IA, &frame[..n], start, &mut out).unwrap_or(0);
+            assert_eq!(&out[..m], want, "start {start:02X}");
+        }
+        // Each re-encoded frame decodes to the same payload, with its own options.
+        let m = reencode(&IA, &frame[..n], 0x32, &mut out).unwrap_or(0);
+        assert_eq!(feed(&mut d, &out[..m]), [Ok((b'R', Some(2), [0x00, 0x5F, 0x02, 0, 0, 7].to_vec()))]);
+        // Not a frame of the default start byte, or a start byte the framing refuses.
+        assert_eq!(reencode(&IA, &out[..m], 0x11, &mut frame), Err(EncodeError::CodeOutOfRange));
+        assert_eq!(reencode(&IA, &out[..0], 0x11, &mut frame), Err(EncodeError::CodeOutOfRange));
+        let n = encode(&IA, b'R', &[1], &mut frame).unwrap_or(0);
+        assert_eq!(reencode(&IA, &frame[..n], 0x10, &mut out), Err(EncodeError::CodeOutOfRange), "network 0 is reserved");
     }
 }
