@@ -389,11 +389,9 @@ mod tests {
         let n = encode(&IA, b'R', &[0x00, 0x5F, 0x02, 0, 0, 7], &mut frame).unwrap_or(0);
         assert_eq!(payload_of(&IA, &frame[..n]), Some(&[b'R', 0x00, 0x5F, 0x02, 0, 0, 7][..]));
         let mut out = [0; 64];
-        for (start, want) in [
-            (0x11, &frame[..n]),
-            (0x01, &[0x01, 0x07, b'R', 0x00, 0x5F, 0x02, 0, 0, 7][..]),
-            (0x21, &[0x21, 0x07, 0x00, b'R', 0x00, 0x5F, 0x02, 0, 0, 7][..]),
-        ] {
+        for (start, want) in
+            [(0x11, &frame[..n]), (0x01, &[0x01, 0x07, b'R', 0x00, 0x5F, 0x02, 0, 0, 7][..]), (0x21, &[0x21, 0x07, 0x00, b'R', 0x00, 0x5F, 0x02, 0, 0, 7][..])]
+        {
             let m = reencode(&IA, &frame[..n], start, &mut out).unwrap_or(0);
             assert_eq!(&out[..m], want, "start {start:02X}");
         }

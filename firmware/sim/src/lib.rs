@@ -15,6 +15,7 @@
 #![cfg_attr(test, allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 pub mod app;
+pub mod canopenia;
 pub mod devices;
 pub mod gw1;
 pub mod hub;

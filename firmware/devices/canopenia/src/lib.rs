@@ -1,8 +1,25 @@
-//! The canopenia device, generated from `spec/canopenia.yaml`: its dictionary, default PDOs, node
-//! settings, serial codecs and app hooks. It runs as a plain CANopen node until its behaviour
-//! is written.
+//! The CANopenIA coprocessor (`spec/canopenia.yaml`): a CANopen node and a minimal manager
+//! that a host drives over a serial line with ESAcademy's remote-access protocol.
+//!
+//! - [`host`]: the host's commands as requests, and the start byte each answer copies;
+//! - [`errors`]: the error-code bits of every local refusal and remote result;
+//! - [`objects`]: the coprocessor's own dictionary hooks: program data, writes to act on;
+//! - [`status`]: NODESTATUS, the codes of 5F04h;
+//! - [`cache`]: remote reads answered from the manager's scans;
+//! - [`device`]: the whole coprocessor, driven by CAN frames, serial bytes and time.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(warnings)]
+#![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
+#![cfg_attr(test, allow(clippy::indexing_slicing, clippy::unwrap_used))]
 
 coforge_macros::device!("../../../spec/canopenia.yaml");
+
+pub mod cache;
+pub mod device;
+pub mod errors;
+pub mod host;
+pub mod objects;
+pub mod status;
+
+pub use device::Canopenia;

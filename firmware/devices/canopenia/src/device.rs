@@ -1,0 +1,490 @@
+//! The coprocessor: the CANopen node, the manager beside it, and the remote-access engine
+//! between them and the host (manual chapters 6 and 7).
+//!
+//! - **Commands** W and R read and write the local dictionary with the host's access rules
+//!   and the side effects of an SDO write (an event TPDO, a reloaded service). S and U go to
+//!   another node through the manager's SDO client, one at a time: a second one while one
+//!   runs is answered at once with the busy bit, W and R are served meanwhile, and the answer
+//!   comes when the transfer ends. U with 5F01h.04 bit 4 set answers a scanned entry from the
+//!   cache, at once. S and U addressed to the coprocessor's own node-ID are served from its
+//!   dictionary with the bus's access rules, as the SDO server would.
+//! - **Every accepted command gets exactly one answer**, in the form of its start byte
+//!   (network, CRC or none, 8- or 16-bit length). A command is accepted when its answer fits
+//!   the output queue (besides the answer a running S or U is owed); otherwise it is refused,
+//!   and counted, like a frame with a bad CRC or a letter the protocol does not have.
+//! - **Indications D**: every local entry written from the bus (an SDO download; an RPDO, one
+//!   D per mapped entry); with 5F01h.04 bit 2 every TPDO of a scanned node, split by its
+//!   scanned mapping; the coprocessor's own node-ID, NMT state and hardware state (5F00h.01..03)
+//!   when they change; and every status the manager records of a node (5F04h, sub-index =
+//!   node-ID). An indication never takes the room an owed answer needs: it is dropped and
+//!   counted instead. Indications use the start byte of the host's latest command (11h first).
+//! - **The manager's command entries**: 5F0Ah.1 sends an NMT master message, 5F01h.1 resets
+//!   the coprocessor (129: reset application, 130: reset communication), 5F01h.0Ah scans a
+//!   node again.
+
+use crate::app::Typed;
+use crate::errors;
+use crate::host::{self, Command, MAX_VALUE, Request};
+use crate::objects::{Coprocessor, Written};
+use crate::serial::{self, DeviceToHost};
+use crate::{Mode, Node, Od, cache, index, status};
+use coforge_link::start_crc::reencode;
+use coforge_link::{Deframer, Millis, Outbox};
+use coforge_stack::device::{Assemble, AssembleError, Device, HostPort, MemoryRequest, NodeAccess, assembly_mode, mode_names};
+use coforge_stack::frame::CanFrame;
+use coforge_stack::leds::Leds;
+use coforge_stack::manager::scan::{MAX_MAPPED, ScanConfig};
+use coforge_stack::manager::{Manager, ManagerEvent, nmt_frame};
+use coforge_stack::nmt::{NmtCommand, state_code};
+use coforge_stack::node::{BusState, NodeEvent};
+use coforge_stack::od::{NodeDictionary, Side};
+use coforge_stack::sdo::client::{SdoResult, StartError};
+use coforge_stack::store::{BlockStore, ParamStore};
+use heapless::Deque;
+
+/// Scans the manager keeps (node records, each with this many PDOs each way).
+pub const SCANS: usize = 8;
+pub const SCAN_PDOS: usize = 4;
+/// The longest frame the device sends: start byte, 16-bit length, 35 payload bytes, CRC.
+const MAX_FRAME: usize = 1 + 2 + 35 + 2;
+/// The host's output queue: an owed answer, a running S or U's answer, indications.
+const OUT: usize = 6 * MAX_FRAME;
+/// Node events kept for the runtime.
+const EVENTS: usize = 8;
+/// 5F01h.04 bits (manual section 9.2).
+const PDO_RECEIVE_ALL: u32 = 1 << 2;
+const USE_SCANNED: u32 = 1 << 4;
+/// 5F00h.03 bits this firmware can see: INIT, ERPA, TXOR, BOFF.
+const HW_INIT: u8 = 1 << 0;
+const HW_ERROR_PASSIVE: u8 = 1 << 2;
+const HW_TX_OVERRUN: u8 = 1 << 4;
+const HW_BUS_OFF: u8 = 1 << 7;
+
+/// The remote operation the SDO client runs for the host, and its command's start byte.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Remote {
+    read: bool,
+    node: u8,
+    index: u16,
+    sub: u8,
+    start: u8,
+}
+
+/// The CANopenIA coprocessor with parameter store `S` (1010h/1011h).
+#[derive(Debug)]
+pub struct Canopenia<S> {
+    node: Node<Typed<Coprocessor>, S>,
+    manager: Manager<SCANS, SCAN_PDOS>,
+    host: serial::Decoder,
+    out: Outbox<OUT>,
+    remote: Option<Remote>,
+    /// The manager's caller buffer: the value S writes, where U's value lands.
+    sdo_buf: [u8; MAX_VALUE],
+    /// The start byte of indications: the host's latest command's.
+    start: u8,
+    /// 5F00h.01..03 as the host was last told.
+    shown: [u8; 3],
+    /// 5F00h.03: what has happened since power-on.
+    hardware: u8,
+    events: Deque<NodeEvent, EVENTS>,
+    /// Host frames that got no answer: a bad start byte, CRC or length, a letter the
+    /// protocol does not have, or no room for the answer.
+    pub host_refusals: u32,
+    /// Indications not sent: no room, or a value longer than an indication carries.
+    pub indications_dropped: u32,
+}
+
+impl<S: ParamStore> Canopenia<S> {
+    pub fn new(node_id: u8, store: S) -> Self {
+        let od = Od::new(Mode::Default, node_id, Typed(Coprocessor::default()));
+        Canopenia {
+            node: Node::new(od, store, crate::node_config(node_id)),
+            manager: Manager::new(ScanConfig { pdos: SCAN_PDOS as u8, heartbeat_ms: None }),
+            host: serial::decoder(),
+            out: Outbox::default(),
+            remote: None,
+            sdo_buf: [0; MAX_VALUE],
+            start: serial::FRAMING.start_byte,
+            shown: [0; 3],
+            hardware: 0,
+            events: Deque::new(),
+            host_refusals: 0,
+            indications_dropped: 0,
+        }
+    }
+
+    pub fn node(&self) -> &Node<Typed<Coprocessor>, S> {
+        &self.node
+    }
+
+    pub fn node_mut(&mut self) -> &mut Node<Typed<Coprocessor>, S> {
+        &mut self.node
+    }
+
+    pub fn manager(&self) -> &Manager<SCANS, SCAN_PDOS> {
+        &self.manager
+    }
+
+    pub fn manager_mut(&mut self) -> &mut Manager<SCANS, SCAN_PDOS> {
+        &mut self.manager
+    }
+
+    fn manager_control(&self) -> u32 {
+        self.node.od().device_control.manager_control
+    }
+
+    /// Room an answer owed to a running S or U keeps in the output queue.
+    fn reserved(&self) -> usize {
+        if self.remote.is_some() { MAX_FRAME } else { 0 }
+    }
+
+    /// Queues `message` with the options of start byte `start`; `false` if it does not fit.
+    fn push(&mut self, message: &DeviceToHost<'_>, start: u8) -> bool {
+        let mut frame = [0_u8; MAX_FRAME];
+        let Ok(n) = message.encode(&mut frame) else { return false };
+        let frame = frame.get(..n).unwrap_or(&[]);
+        self.out.push_with(|out| reencode(&serial::FRAMING, frame, start, out).ok())
+    }
+
+    /// An answer: the room for it was kept when its command was accepted.
+    fn answer(&mut self, request: &Request, err: u16, data: &[u8], start: u8) {
+        let data = if err == 0 { data } else { &[] };
+        let message = match *request {
+            Request::WriteLocal { index, sub, .. } => DeviceToHost::WriteLocalResponse { index, sub, err },
+            Request::ReadLocal { index, sub } => DeviceToHost::ReadLocalResponse { index, sub, err, data },
+            Request::WriteRemote { node, index, sub, .. } => DeviceToHost::WriteRemoteResponse { node_id: node, index, sub, err },
+            Request::ReadRemote { node, index, sub } => DeviceToHost::ReadRemoteResponse { node_id: node, index, sub, err, data },
+        };
+        self.push(&message, start);
+    }
+
+    /// An indication, if it leaves room for the answers that may be owed.
+    fn indicate(&mut self, node_id: u8, index: u16, sub: u8, data: &[u8]) {
+        let fits = data.len() <= MAX_VALUE && self.out.free() >= 1 + 2 + 5 + data.len() + 2 + MAX_FRAME + self.reserved();
+        if !(fits && self.push(&DeviceToHost::NewDataIndication { node_id, index, sub, data }, self.start)) {
+            self.indications_dropped = self.indications_dropped.saturating_add(1);
+        }
+    }
+
+    /// Serves one accepted command.
+    fn serve(&mut self, command: Command, start: u8) {
+        let request = match command {
+            Command::Refuse { request, err } => return self.answer(&request, err, &[], start),
+            Command::Serve(request) => request,
+        };
+        match request {
+            Request::WriteLocal { index, sub, ref data } => {
+                let err = self.node.write(index, sub, data, Side::Host).err().map_or(0, errors::of_abort);
+                self.answer(&request, err, &[], start);
+            }
+            Request::ReadLocal { index, sub } => self.read_local(&request, index, sub, Side::Host, start),
+            Request::WriteRemote { node, .. } | Request::ReadRemote { node, .. } if node == self.node.node_id() => self.serve_own(&request, start),
+            Request::WriteRemote { node, index, sub, ref data } => {
+                if let Some(err) = self.remote_refusal(node) {
+                    return self.answer(&request, err, &[], start);
+                }
+                let len = data.len();
+                self.sdo_buf.iter_mut().zip(data).for_each(|(d, s)| *d = *s);
+                let started = self.manager.download(node, index, sub, len);
+                self.start_remote(&request, started, Remote { read: false, node, index, sub, start });
+            }
+            Request::ReadRemote { node, index, sub } => {
+                if let Some(err) = self.remote_refusal(node) {
+                    return self.answer(&request, err, &[], start);
+                }
+                let cached =
+                    (self.manager_control() & USE_SCANNED != 0).then(|| self.manager.scanned(node).and_then(|s| cache::value(s, index, sub))).flatten();
+                if let Some((bytes, len)) = cached {
+                    return self.answer(&request, 0, bytes.get(..len).unwrap_or(&[]), start);
+                }
+                let started = self.manager.upload(node, index, sub);
+                self.start_remote(&request, started, Remote { read: true, node, index, sub, start });
+            }
+        }
+    }
+
+    /// R, or S/U addressed to the coprocessor itself (with the bus's rules).
+    fn read_local(&mut self, request: &Request, index: u16, sub: u8, side: Side, start: u8) {
+        let mut buf = [0_u8; MAX_VALUE];
+        let (err, len) = match self.node.read(index, sub, 0, &mut buf, side) {
+            Ok(read) if read.total > MAX_VALUE => (serial::errors::RECEIVE_BUFFER_TOO_SMALL, 0),
+            Ok(read) => (0, read.copied),
+            Err(abort) => (errors::of_abort(abort), 0),
+        };
+        self.answer(request, err, buf.get(..len).unwrap_or(&[]), start);
+    }
+
+    fn serve_own(&mut self, request: &Request, start: u8) {
+        match *request {
+            Request::WriteRemote { index, sub, ref data, .. } => {
+                let err = self.node.write(index, sub, data, Side::Bus).err().map_or(0, errors::of_abort);
+                self.answer(request, err, &[], start);
+            }
+            Request::ReadRemote { index, sub, .. } => self.read_local(request, index, sub, Side::Bus, start),
+            _ => {}
+        }
+    }
+
+    /// Why S or U to `node` cannot start now.
+    fn remote_refusal(&self, node: u8) -> Option<u16> {
+        if self.remote.is_some() {
+            Some(serial::errors::BUSY)
+        } else if !(1..=127).contains(&node) {
+            Some(serial::errors::INVALID_COMMAND)
+        } else {
+            None
+        }
+    }
+
+    fn start_remote(&mut self, request: &Request, started: Result<(), StartError>, remote: Remote) {
+        match started {
+            Ok(()) => self.remote = Some(remote),
+            Err(StartError::Busy) => self.answer(request, serial::errors::BUSY, &[], remote.start),
+            Err(StartError::NodeId) => self.answer(request, serial::errors::INVALID_COMMAND, &[], remote.start),
+            Err(StartError::TooLong) => self.answer(request, serial::errors::INVALID_COMMAND_LENGTH, &[], remote.start),
+        }
+    }
+
+    /// The running S or U ended: its answer.
+    fn remote_done(&mut self, result: SdoResult) {
+        let Some(r) = self.remote.take() else { return };
+        let err = errors::of_remote(&result);
+        let len = match result {
+            SdoResult::Uploaded { len } => len,
+            _ => 0,
+        };
+        let value = self.sdo_buf;
+        let data = value.get(..len).unwrap_or(&[]);
+        let request = if r.read {
+            Request::ReadRemote { node: r.node, index: r.index, sub: r.sub }
+        } else {
+            Request::WriteRemote { node: r.node, index: r.index, sub: r.sub, data: host::Value::new() }
+        };
+        self.answer(&request, err, data, r.start);
+    }
+
+    /// The end of every input: what the dictionary, the manager and the node have to say.
+    fn after_input(&mut self, now_us: u64) {
+        while let Some(written) = self.node.od_mut().app.take_write() {
+            self.on_written(&written, now_us);
+        }
+        let dropped = core::mem::take(&mut self.node.od_mut().app.writes_dropped);
+        self.indications_dropped = self.indications_dropped.saturating_add(dropped);
+        while let Some(event) = self.manager.take_event() {
+            self.on_manager_event(&event);
+        }
+        self.take_node_events();
+        self.show_own_status();
+    }
+
+    /// A write the device acts on or tells the host of.
+    fn on_written(&mut self, w: &Written, now_us: u64) {
+        if w.from_bus() {
+            // The sender of an SDO download or an RPDO is not known: node-ID 0.
+            self.indicate(0, w.index, w.sub, &w.data);
+        }
+        let [lo, hi] = [w.data.first().copied().unwrap_or(0), w.data.get(1).copied().unwrap_or(0)];
+        match (w.index, w.sub) {
+            (index::NMT_MASTER_MESSAGE, 1) => self.nmt_master(lo, hi),
+            (index::DEVICE_CONTROL, 1) => {
+                let command = if lo == 129 { NmtCommand::ResetNode } else { NmtCommand::ResetCommunication };
+                // The reset the coprocessor would get from the bus, addressed to itself.
+                if let Some(frame) = nmt_frame(command, self.node.node_id()) {
+                    self.node.on_frame(&frame, now_us);
+                }
+            }
+            (index::DEVICE_CONTROL, 0x0A) => self.manager.scan(lo & 0x7F),
+            _ => {}
+        }
+    }
+
+    /// 5F0Ah.1: `command` to `node` (0: every node); a reset is recorded in 5F04h.
+    fn nmt_master(&mut self, command: u8, node: u8) {
+        let Some(nmt) = NmtCommand::from_code(command) else { return };
+        if !self.manager.nmt(nmt, node) {
+            return;
+        }
+        let code = match nmt {
+            NmtCommand::ResetNode => status::RESET_APP,
+            NmtCommand::ResetCommunication => status::RESET_COM,
+            _ => return,
+        };
+        // A broadcast resets every node the manager has heard of.
+        let known = |m: &Manager<SCANS, SCAN_PDOS>, n: u8| m.status(n).is_some_and(|s| s.state != Default::default());
+        for n in if node == 0 { 1..=127 } else { node..=node } {
+            if node != 0 || known(&self.manager, n) {
+                self.record_status(n, code);
+            }
+        }
+    }
+
+    fn on_manager_event(&mut self, event: &ManagerEvent) {
+        if let ManagerEvent::Sdo(result) = *event {
+            return self.remote_done(result);
+        }
+        if let Some((node, codes)) = status::of_event(event) {
+            for code in codes.into_iter().flatten() {
+                self.record_status(node, code);
+            }
+        }
+    }
+
+    /// 5F04h.`node` = `code`, and the host is told.
+    fn record_status(&mut self, node: u8, code: u8) {
+        if let Some(slot) = self.node.od_mut().status_of_all_nodes.items.get_mut(usize::from(node).wrapping_sub(1)) {
+            *slot = code;
+            let own = self.node.node_id();
+            self.indicate(own, index::STATUS_OF_ALL_NODES, node, &[code]);
+        }
+    }
+
+    fn take_node_events(&mut self) {
+        while let Some(event) = self.node.take_event() {
+            if event == NodeEvent::ResetApplication || event == NodeEvent::ResetCommunication {
+                // The dictionary was reloaded: the status entries hold the defaults again.
+                self.shown = [0xFF; 3];
+            }
+            if self.events.is_full() {
+                self.events.pop_front();
+            }
+            let _ = self.events.push_back(event);
+        }
+    }
+
+    /// 5F00h.01..03 from the node, and an indication for each that changed.
+    fn show_own_status(&mut self) {
+        if self.node.tx_overflows() > 0 || self.manager.tx_overflows > 0 {
+            self.hardware |= HW_TX_OVERRUN;
+        }
+        let now = [self.node.node_id(), state_code(self.node.state()), self.hardware];
+        let status = &mut self.node.od_mut().device_status;
+        (status.device_status_own_node_id, status.device_status_own_nmt_state, status.device_status_own_hw_state) = (now[0], now[1], now[2]);
+        for (sub, (&value, shown)) in (1..).zip(now.iter().zip(self.shown)) {
+            if value != shown {
+                self.indicate(now[0], index::DEVICE_STATUS, sub, &[value]);
+            }
+        }
+        self.shown = now;
+    }
+
+    /// With 5F01h.04 bit 2: a TPDO of a scanned node, one D per mapped entry.
+    fn receive_all(&mut self, frame: &CanFrame) {
+        if self.manager_control() & PDO_RECEIVE_ALL == 0 || frame.rtr {
+            return;
+        }
+        let id = u32::from(frame.id);
+        let Some((node, mapping)) = self.manager.scans().iter().find_map(|s| {
+            s.tpdos
+                .iter()
+                .find(|p| p.is_valid() && p.cob_id & 0x7FF == id)
+                .map(|p| (s.node, heapless::Vec::<u32, MAX_MAPPED>::from_slice(p.mapping()).unwrap_or_default()))
+        }) else {
+            return;
+        };
+        let data = u64::from_le_bytes(frame.data);
+        let mut at = 0_u32;
+        for entry in mapping.iter() {
+            let bits = entry & 0xFF;
+            if bits == 0 || at + bits > u32::from(frame.dlc) * 8 {
+                break;
+            }
+            let value = (data >> at) & (u64::MAX >> (64 - bits));
+            let bytes = value.to_le_bytes();
+            self.indicate(node, (entry >> 16) as u16, (entry >> 8) as u8, bytes.get(..bits.div_ceil(8) as usize).unwrap_or(&[]));
+            at += bits;
+        }
+    }
+}
+
+impl<S: ParamStore> Device for Canopenia<S> {
+    fn start(&mut self, now_us: u64) {
+        self.node.start(now_us);
+        self.hardware = HW_INIT;
+        self.shown = [0xFF; 3];
+        self.after_input(now_us);
+    }
+
+    /// Every frame goes to the node and to the manager (their COB-IDs do not overlap: the
+    /// manager takes other nodes' answers, boot-ups, heartbeats and emergencies).
+    fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
+        self.node.on_frame(frame, now_us);
+        self.manager.on_frame(frame, now_us, &mut self.sdo_buf);
+        self.receive_all(frame);
+        self.after_input(now_us);
+    }
+
+    fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
+        let frame = self.node.poll(now_us).or_else(|| self.manager.poll(now_us, &mut self.sdo_buf));
+        self.after_input(now_us);
+        frame
+    }
+
+    fn on_bus_state(&mut self, bus: BusState, now_us: u64) {
+        self.hardware |= match bus {
+            BusState::Passive => HW_ERROR_PASSIVE,
+            BusState::BusOff => HW_BUS_OFF,
+            _ => 0,
+        };
+        self.node.on_bus_state(bus, now_us);
+        self.after_input(now_us);
+    }
+
+    fn take_event(&mut self) -> Option<NodeEvent> {
+        self.events.pop_front()
+    }
+
+    fn leds(&self) -> Leds {
+        self.node.leds()
+    }
+
+    fn node(&self) -> &dyn NodeAccess {
+        &self.node
+    }
+
+    fn node_mut(&mut self) -> &mut dyn NodeAccess {
+        &mut self.node
+    }
+
+    fn host_port(&mut self) -> Option<&mut dyn HostPort> {
+        Some(self)
+    }
+}
+
+impl<S: ParamStore> HostPort for Canopenia<S> {
+    fn on_host_byte(&mut self, byte: u8, now_ms: u64) {
+        // The framing compares wrapping differences of a 32-bit millisecond clock.
+        let command = match self.host.push(byte, now_ms as Millis) {
+            None => return,
+            Some(Ok(frame)) => host::command(&frame),
+            Some(Err(_)) => None,
+        };
+        let start = self.host.start_byte();
+        match command {
+            Some(command) if self.out.free() >= MAX_FRAME + self.reserved() => {
+                self.start = start;
+                self.serve(command, start);
+            }
+            _ => self.host_refusals = self.host_refusals.saturating_add(1),
+        }
+        self.after_input(now_ms.saturating_mul(1000));
+    }
+
+    fn host_output(&mut self, _now_ms: u64, out: &mut [u8]) -> usize {
+        self.out.take(out)
+    }
+}
+
+/// The coprocessor at `node_id` with its parameters in a block store from the runtime.
+impl<M: embedded_storage::Storage> Assemble<M> for Canopenia<BlockStore<M>> {
+    fn mode_names(f: &mut dyn FnMut(&'static str)) {
+        mode_names::<Od<Typed<Coprocessor>>>(f);
+    }
+
+    fn assemble(mode: Option<&str>, node_id: u8, memory: &mut dyn FnMut(MemoryRequest) -> Option<M>) -> Result<Self, AssembleError> {
+        assembly_mode::<Od<Typed<Coprocessor>>>(mode, node_id)?;
+        let size = <Od<Typed<Coprocessor>> as NodeDictionary>::PERSISTENT_SIZE;
+        let request = MemoryRequest { name: "parameters", capacity: BlockStore::<M>::capacity_for(size) };
+        let storage = memory(request).ok_or(AssembleError::NoMemory(request.name))?;
+        Ok(Canopenia::new(node_id, BlockStore::new(storage, 0)))
+    }
+}

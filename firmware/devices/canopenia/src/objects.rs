@@ -1,0 +1,76 @@
+//! The coprocessor's own part of its dictionary (the generated `app::Hooks`): 1F50h's program
+//! data, and every write the rest of the device acts on, kept until the device takes it after
+//! the input that caused it:
+//! - writes from the bus (an SDO download, an RPDO) of any entry: indications `D` to the host;
+//! - writes of the manager's command entries from any side: 5F0Ah.1 (an NMT master message),
+//!   5F01h.1 (a reset of the coprocessor), 5F01h.0Ah (scan a node again).
+
+use crate::app::Hooks;
+use crate::index;
+use coforge_stack::od::{ReadLen, SdoAbort, WriteSource};
+use heapless::Deque;
+
+/// Bytes of a written value kept: the most a PDO carries, and more than the node's largest
+/// SDO-writable entry (`od::MAX_WRITE_SIZE`).
+pub const WRITTEN_MAX: usize = 8;
+/// Writes kept between two inputs: every entry of two full RPDOs.
+const WRITES: usize = 16;
+
+/// A write that took effect.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Written {
+    pub index: u16,
+    pub sub: u8,
+    pub data: heapless::Vec<u8, WRITTEN_MAX>,
+    pub by: WriteSource,
+}
+
+impl Written {
+    /// Whether the host is told of it: it came from the bus.
+    pub fn from_bus(&self) -> bool {
+        matches!(self.by, WriteSource::Sdo | WriteSource::Rpdo)
+    }
+}
+
+/// Whether the device acts on writes of this entry, whoever writes it.
+fn is_command_entry(index: u16, sub: u8) -> bool {
+    matches!((index, sub), (index::NMT_MASTER_MESSAGE, 1) | (index::DEVICE_CONTROL, 1 | 0x0A))
+}
+
+/// The app side of the dictionary.
+#[derive(Debug, Default)]
+pub struct Coprocessor {
+    writes: Deque<Written, WRITES>,
+    /// Writes not kept: the queue was full, or the value longer than [`WRITTEN_MAX`].
+    pub writes_dropped: u32,
+}
+
+impl Coprocessor {
+    /// The oldest write not taken yet.
+    pub fn take_write(&mut self) -> Option<Written> {
+        self.writes.pop_front()
+    }
+}
+
+impl Hooks for Coprocessor {
+    /// Program data is the configuration loading interface, served in bootloader mode only
+    /// (manual section 4.2); this firmware runs the application.
+    fn read_program_data(&mut self, _sub: u8, _offset: usize, _buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
+        Err(SdoAbort::DataTransferState)
+    }
+
+    fn write_program_data(&mut self, _sub: u8, _data: &[u8]) -> Result<(), SdoAbort> {
+        Err(SdoAbort::DataTransferState)
+    }
+
+    fn written(&mut self, index: u16, sub: u8, data: &[u8], by: WriteSource) {
+        let from_bus = matches!(by, WriteSource::Sdo | WriteSource::Rpdo);
+        if !from_bus && !is_command_entry(index, sub) {
+            return;
+        }
+        let kept = heapless::Vec::from_slice(data).ok().is_some_and(|data| self.writes.push_back(Written { index, sub, data, by }).is_ok());
+        if !kept {
+            self.writes_dropped = self.writes_dropped.saturating_add(1);
+        }
+    }
+}
