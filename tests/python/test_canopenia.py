@@ -1,0 +1,257 @@
+"""CANopenIA's remote-access protocol end to end: a host written from the manual (chapter 6:
+start byte, length, payload, CRC-16) on the simulator's serial port, and python-canopen as a
+CANopen master on the same bus, both against `coforge sim canopenia --node-id 2`.
+
+The host side encodes and checks every frame itself, from the manual and errata COIA-01..03
+(CRC-16/XMODEM over length and payload, sent low byte first; the length counts the payload).
+Expected bytes are the manual's examples where it prints them (spec `serial.commands[].examples`).
+Answers may be preceded by indications (D); the host separates them by their letter, as a real
+host does. Every wait has a timeout; the simulator runs in real time.
+"""
+
+import os
+import pathlib
+import subprocess
+import tempfile
+import time
+
+from bus import Recorder
+from simproc import SerialLine, SimProcess
+import canopen
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
+SPEC = ROOT / "spec" / "canopenia.yaml"
+
+NODE_ID = 2
+WAIT = 3.0
+SDO_TIMEOUT = 1.0  # the coprocessor's SDO client gives up after 1 s
+
+BIT_NOT_FOUND, BIT_LENGTH, BIT_INVALID, BIT_BUSY = 1 << 0, 1 << 1, 1 << 2, 1 << 3
+BIT_ABORTED, BIT_TIMEOUT, BIT_NOT_SUPPORTED = 1 << 6, 1 << 9, 1 << 11
+
+
+def crc16(data):
+    """CRC-16/XMODEM (erratum COIA-01: polynomial 0x1021, start 0, no reflection)."""
+    crc = 0
+    for b in data:
+        crc ^= b << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
+    return crc
+
+
+def encode(payload, start=0x11):
+    """A frame: start byte (bit 4: CRC, bit 5: 16-bit length), length, payload, CRC."""
+    length = len(payload).to_bytes(2 if start & 0x20 else 1, "little")
+    frame = bytes([start]) + length + payload
+    if start & 0x10:
+        frame += crc16(length + payload).to_bytes(2, "little")
+    return frame
+
+
+class Host(SerialLine):
+    """The host end: frames in, frames out, each checked against the framing."""
+
+    def __init__(self, url):
+        super().__init__(url)
+        self.pending = b""
+        self.indications = []
+
+    def frame(self, timeout=WAIT):
+        """The next frame from the device: (start byte, payload). Fails on a bad one."""
+        deadline = time.monotonic() + timeout
+        while True:
+            got = self.parse()
+            if got is not None:
+                return got
+            more = self._read(1, deadline)
+            assert more, f"no frame from the device within {timeout} s (have {self.pending.hex(' ')})"
+            self.pending += more
+
+    def parse(self):
+        if not self.pending:
+            return None
+        start = self.pending[0]
+        assert start & 0x0F and not start & 0xC0, f"bad start byte {start:02X}"
+        lb = 2 if start & 0x20 else 1
+        if len(self.pending) < 1 + lb:
+            return None
+        n = int.from_bytes(self.pending[1 : 1 + lb], "little")
+        total = 1 + lb + n + (2 if start & 0x10 else 0)
+        if len(self.pending) < total:
+            return None
+        frame, self.pending = self.pending[:total], self.pending[total:]
+        payload = frame[1 + lb : 1 + lb + n]
+        if start & 0x10:
+            assert int.from_bytes(frame[-2:], "little") == crc16(frame[1 : 1 + lb + n]), f"bad CRC in {frame.hex(' ')}"
+        assert len(payload) <= 35, "never more than 35 payload bytes"
+        return start, payload
+
+    def answer(self, timeout=WAIT):
+        """The next frame that is not an indication (indications are kept)."""
+        while True:
+            start, payload = self.frame(timeout)
+            if payload[:1] == b"D":
+                self.indications.append(payload)
+            else:
+                return start, payload
+
+    def xfer(self, payload, start=0x11, timeout=WAIT):
+        self.send(encode(payload, start))
+        return self.answer(timeout)
+
+    def raw_xfer(self, frame, timeout=WAIT):
+        """A frame as the manual prints it; the answer frame re-encoded as it came."""
+        self.send(frame)
+        start, payload = self.answer(timeout)
+        return encode(payload, start)
+
+    def silent(self, timeout=0.3):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            self.pending += self._read(1, deadline)
+            while True:
+                got = self.parse()
+                if got is None:
+                    break
+                assert got[1][:1] == b"D", f"unexpected answer {got[1].hex(' ')}"
+                self.indications.append(got[1])
+
+    def indication(self, payload, timeout=WAIT):
+        """Waits until `payload` was indicated."""
+        deadline = time.monotonic() + timeout
+        while payload not in self.indications:
+            left = deadline - time.monotonic()
+            assert left > 0, f"no indication {payload.hex(' ')}; got {[i.hex(' ') for i in self.indications]}"
+            self.silent(min(left, 0.1))
+
+
+def err_of(payload, at):
+    return int.from_bytes(payload[at : at + 2], "little")
+
+
+class Sim:
+    def __init__(self):
+        self.sim = SimProcess([COFORGE, "sim", "canopenia", "--node-id", str(NODE_ID), "--port", "0", "--serial", "0"])
+        self.net = self.host = None
+        try:
+            serial_url = self.sim.banner(r"serial host on (socket://\S+)")
+            can_url = self.sim.banner(rf"canopenia node-ID {NODE_ID} on slcan (socket://\S+)")
+            with tempfile.TemporaryDirectory() as d:
+                eds = pathlib.Path(d) / "canopenia.eds"
+                subprocess.run([COFORGE, "eds", SPEC, "-o", eds], check=True, timeout=60)
+                od = canopen.import_od(str(eds), NODE_ID)
+            self.net = canopen.Network()
+            self.rec = Recorder()
+            self.net.listeners.insert(0, self.rec)
+            self.net.connect(interface="slcan", channel=can_url, sleep_after_open=0, bitrate=500000)
+            self.node = canopen.RemoteNode(NODE_ID, od)
+            self.node.sdo.RESPONSE_TIMEOUT = 1.0
+            self.net.add_node(self.node)
+            self.host = Host(serial_url)
+            # The coprocessor serves its host at once: a read of 1000h proves the line works.
+            assert self.host.xfer(b"R\x00\x10\x00")[1][:1] == b"R"
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self):
+        try:
+            if self.host is not None:
+                self.host.close()
+            if self.net is not None:
+                self.net.disconnect()
+        finally:
+            self.sim.stop()
+
+    def start_node(self):
+        """python-canopen starts the coprocessor; the host is told of its new state."""
+        mark = self.rec.mark()
+        self.node.nmt.send_command(0x01)
+        self.host.indication(b"D" + bytes([NODE_ID]) + bytes.fromhex("00 5F 02 05"))
+        return mark
+
+
+@pytest.fixture
+def sim():
+    s = Sim()
+    try:
+        yield s
+    finally:
+        s.close()
+
+
+def test_the_manuals_local_examples_byte_for_byte(sim):
+    sim.start_node()
+    host = sim.host
+    mark = sim.rec.mark()
+    # Transmit NMT "start all nodes" through 5F0Ah (section 9.4): accepted, and on the bus.
+    assert host.raw_xfer(bytes.fromhex("11 06 57 0A 5F 01 01 00 8A FA")) == bytes.fromhex("11 06 57 0A 5F 01 00 00 BB C9")
+    assert sim.rec.wait(0x000, mark, WAIT, lambda f: f.data == bytes([0x01, 0x00])) is not None
+    # Own NMT state (operational) and own node-ID, as the manual's answers print them.
+    assert host.raw_xfer(bytes.fromhex("11 04 52 00 5F 02 96 2F")) == bytes.fromhex("11 07 52 00 5F 02 00 00 05 6A 80")
+    assert host.raw_xfer(encode(b"R\x00\x5F\x01")) == bytes.fromhex("11 07 52 00 5F 01 00 00 02 51 6B")
+    # 1000h, the device type of the spec.
+    start, payload = host.xfer(bytes.fromhex("52 00 10 00"))
+    assert payload == b"R\x00\x10\x00\x00\x00" + (0x00030191).to_bytes(4, "little")
+
+
+def test_error_bits_start_byte_options_and_resync(sim):
+    host = sim.host
+    # No such object; a host write of a read-only status entry; a value of the wrong size.
+    assert err_of(host.xfer(b"R\x45\x23\x00")[1], 4) == BIT_NOT_FOUND
+    assert err_of(host.xfer(b"W\x00\x5F\x01\x05")[1], 4) == BIT_NOT_SUPPORTED
+    assert err_of(host.xfer(b"W\x00\x60\x01\x01\x02")[1], 4) == BIT_LENGTH
+    # A command cut short is answered with the invalid-length bit.
+    assert err_of(host.xfer(b"R\x00\x10")[1], 4) == BIT_LENGTH
+    # The answer takes the form of the command: no CRC; 16-bit length; another network.
+    start, payload = host.xfer(b"R\x00\x10\x00", start=0x01)
+    assert start == 0x01 and err_of(payload, 4) == 0
+    start, payload = host.xfer(b"R\x00\x10\x00", start=0x31)
+    assert start == 0x31 and err_of(payload, 4) == 0
+    start, payload = host.xfer(b"R\x00\x10\x00", start=0x13)
+    assert start == 0x13 and err_of(payload, 4) == BIT_NOT_SUPPORTED
+    # Garbage, a bad CRC, a frame cut off by garbage, an unknown letter: no answer. Then the
+    # next valid frame is answered.
+    bad = bytearray(encode(b"R\x00\x10\x00"))
+    bad[-1] ^= 0xFF
+    host.send(b"\x00\xc0\xff" + bytes(bad) + encode(b"X\x01\x02"))
+    host.silent(0.3)
+    assert host.xfer(b"R\x00\x10\x00")[1][4:6] == b"\x00\x00"
+
+
+def test_remote_operations_busy_and_timeout(sim):
+    host = sim.host
+    # U of node 3's vendor-ID (the manual's example frame): no node 3 on this bus.
+    t0 = time.monotonic()
+    host.send(bytes.fromhex("11 05 55 03 18 10 01 28 17"))
+    # A second remote operation meanwhile is busy at once; W/R are served meanwhile.
+    start, payload = host.xfer(b"S\x04\x17\x10\x00\x64\x00")
+    assert payload[:5] == b"S\x04\x17\x10\x00" and err_of(payload, 5) == BIT_BUSY
+    assert host.xfer(b"R\x00\x10\x00")[1][:1] == b"R"
+    start, payload = host.answer(timeout=SDO_TIMEOUT + WAIT)
+    assert payload[:5] == bytes.fromhex("55 03 18 10 01")
+    assert err_of(payload, 5) == BIT_ABORTED | BIT_TIMEOUT
+    assert time.monotonic() - t0 >= SDO_TIMEOUT * 0.9
+    # A node-ID no node can have.
+    assert err_of(host.xfer(b"U\x80\x00\x10\x00")[1], 5) == BIT_INVALID
+    # Its own node-ID: served from its own dictionary.
+    start, payload = host.xfer(bytes([0x55, NODE_ID, 0x00, 0x10, 0x00]))
+    assert err_of(payload, 5) == 0 and payload[7:] == (0x00030191).to_bytes(4, "little")
+
+
+def test_writes_from_the_bus_and_state_changes_are_indicated(sim):
+    sim.start_node()
+    # A master writes 6200h.1 by SDO: D with sender 0 (an SDO client is not known).
+    sim.node.sdo.download(0x6200, 1, b"\xa5")
+    sim.host.indication(bytes.fromhex("44 00 00 62 01 A5"))
+    # RPDO1 carries 8 output bytes: one D per mapped entry.
+    sim.net.send_message(0x200 + NODE_ID, bytes(range(1, 9)))
+    for i in range(1, 9):
+        sim.host.indication(bytes([0x44, 0x00, 0x00, 0x62, i, i]))
+    # A host write is not indicated back to the host.
+    sim.host.xfer(b"W\x00\x62\x01\x07")
+    sim.host.silent(0.3)
+    assert bytes.fromhex("44 00 00 62 01 07") not in sim.host.indications
