@@ -29,8 +29,9 @@ pub struct Bench {
 pub const BENCHES: &[Bench] = &[
     Bench { image: "bench-memory1", device: "co401memory1", title: "CO401Memory1" },
     Bench { image: "bench-gw1", device: "co401gw1", title: "CO401GW1" },
-    // Not a device: the manager of coforge-stack, which CANopenIA will run.
+    // Not a device: the manager of coforge-stack, which CANopenIA runs.
     Bench { image: "bench-manager", device: "manager", title: "coforge-stack manager (127 nodes monitored, 31 scans cached)" },
+    Bench { image: "bench-canopenia", device: "canopenia", title: "CANopenIA (remote access, 8 scans cached)" },
 ];
 /// A run takes well under a second; this only stops a hung image.
 const QEMU_TIMEOUT: Duration = Duration::from_secs(120);

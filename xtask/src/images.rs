@@ -22,11 +22,12 @@ pub const BOARDS: &[Board] = &[QEMU, STM32F0];
 
 /// QEMU's lm3s6965evb (`firmware/boards/qemu`): 256 KiB of flash, 64 KiB of RAM.
 /// `co401memory1-files` is the same module with its banks in host files (semihosting);
-/// `co401gw1` keeps its parameters in a host file too, and has a pin console on UART2.
+/// `co401gw1` keeps its parameters in a host file too, and has a pin console on UART2;
+/// `canopenia` keeps its parameters in a host file.
 const QEMU: Board = Board {
     name: "qemu",
     target: "thumbv7m-none-eabi",
-    devices: &["co401memory1", "co401memory1-files", "co401gw1"],
+    devices: &["co401memory1", "co401memory1-files", "co401gw1", "canopenia"],
     features: &[],
     flash: (0, 256 * 1024),
     ram: (0x2000_0000, 64 * 1024),

@@ -156,11 +156,13 @@ fn test() -> Result {
     // The raw binary `dist` wrote: the tests run exactly what would be flashed.
     let qemu_image = root().join("target/dist/images/co401memory1-qemu.bin");
     let gw1_qemu_image = root().join("target/dist/images/co401gw1-qemu.bin");
+    let ia_qemu_image = root().join("target/dist/images/canopenia-qemu.bin");
     let status = Command::new(&python)
         .args(["-m", "pytest", "-q", "tests/python"])
         .env("COFORGE_BIN", &coforge)
         .env("COFORGE_QEMU_IMAGE", &qemu_image)
         .env("COFORGE_GW1_QEMU_IMAGE", &gw1_qemu_image)
+        .env("COFORGE_IA_QEMU_IMAGE", &ia_qemu_image)
         .current_dir(root())
         .status()
         .map_err(|e| format!("cannot run pytest: {e}"))?;

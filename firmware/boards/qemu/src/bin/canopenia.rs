@@ -1,0 +1,48 @@
+//! CANopenIA on QEMU's lm3s6965evb: node-ID 2, the remote-access protocol of its host on
+//! UART0, the coprocessor's CAN side as an SLCAN adapter on UART1 (see `serve`). QEMU's
+//! UARTs have no bit rate, so the manual's 921600 8N1 is what a board's UART would be set to.
+//! The parameters 1010h saves are kept in the host file `canopenia.params` (QEMU's working
+//! directory) through semihosting, so they survive a restart of QEMU.
+//!
+//! ```text
+//! qemu-system-arm -machine lm3s6965evb -nographic -monitor none \
+//!     -semihosting-config enable=on,target=native -kernel canopenia \
+//!     -serial tcp:127.0.0.1:P0,server=on,wait=off,nodelay=on \
+//!     -serial tcp:127.0.0.1:P1,server=on,wait=off,nodelay=on
+//! ```
+#![no_std]
+#![no_main]
+
+use canopenia::app::Typed;
+use canopenia::objects::Coprocessor;
+use canopenia::{Canopenia, Od};
+use coforge_board_qemu::host_file::HostFileEeprom;
+use coforge_board_qemu::serve::serve;
+use coforge_stack::od::NodeDictionary;
+use coforge_stack::store::BlockStore;
+use cortex_m_rt::entry;
+use panic_semihosting as _;
+
+type Store = BlockStore<HostFileEeprom<'static>>;
+type Device = Canopenia<Store>;
+
+/// The parameter file: the two slots of the persistent entries' block.
+const PARAMS: usize = Store::capacity_for(<Od<Typed<Coprocessor>> as NodeDictionary>::PERSISTENT_SIZE);
+/// The node-ID its configuration gives it.
+const NODE_ID: u8 = 2;
+
+#[entry]
+fn main() -> ! {
+    // The parameter file's RAM image, in .bss (cortex-m-rt makes it `&'static mut`, no unsafe).
+    static mut PARAMS_IMAGE: [u8; PARAMS] = [0; PARAMS];
+    let Ok(file) = HostFileEeprom::open("canopenia.params\0", PARAMS_IMAGE) else { panic!("cannot open canopenia.params (is semihosting enabled?)") };
+    serve(mount(BlockStore::new(file, 0)))
+}
+
+/// The coprocessor in a static, built in a frame of its own so that its construction's
+/// temporaries leave the stack before the loop starts (see `co401memory1`).
+#[inline(never)]
+fn mount(store: Store) -> &'static mut Device {
+    let Some(device) = cortex_m::singleton!(: Device = Canopenia::new(NODE_ID, store)) else { panic!("started twice") };
+    device
+}
