@@ -143,6 +143,10 @@ impl<S: ParamStore> Canopenia<S> {
         let mut frame = [0_u8; MAX_FRAME];
         let Ok(n) = message.encode(&mut frame) else { return false };
         let frame = frame.get(..n).unwrap_or(&[]);
+        if start == serial::FRAMING.start_byte {
+            // Already in its form: copied, not encoded again.
+            return self.out.push_with(|out| out.get_mut(..n).map(|dst| dst.copy_from_slice(frame)).map(|()| n));
+        }
         self.out.push_with(|out| reencode(&serial::FRAMING, frame, start, out).ok())
     }
 
