@@ -193,7 +193,8 @@ fn remote_reads_and_writes_through_the_manager_one_at_a_time() {
         ]
     );
     // Two in one burst: the second is busy at once, a W in between is served meanwhile.
-    let mut burst = frame(&HostToDevice::ReadRemoteRequest { node_id: MEM, index: 0x1000, sub: 0 }, 0x11);
+    // (1017h is not in the scan cache: this U goes to the node.)
+    let mut burst = frame(&HostToDevice::ReadRemoteRequest { node_id: MEM, index: 0x1017, sub: 0 }, 0x11);
     burst.extend(frame(&HostToDevice::WriteRemoteRequest { node_id: MEM, index: 0x1017, sub: 0, data: &[0, 0] }, 0x11));
     burst.extend(frame(&HostToDevice::WriteLocalRequest { index: 0x6000, sub: 3, data: &[7] }, 0x11));
     net.host_bytes(&burst);
@@ -202,7 +203,7 @@ fn remote_reads_and_writes_through_the_manager_one_at_a_time() {
         [
             Out::S { node: MEM, index: 0x1017, sub: 0, err: 1 << 3 },
             Out::W { index: 0x6000, sub: 3, err: 0 },
-            Out::U { node: MEM, index: 0x1000, sub: 0, err: 0, data: vec![0x91, 0x01, 0x03, 0x00] }
+            Out::U { node: MEM, index: 0x1017, sub: 0, err: 0, data: vec![100, 0] }
         ]
     );
     // A node that is not there: the SDO client's timeout, and the node-IDs no node can have.
@@ -247,6 +248,7 @@ fn the_host_is_told_of_bus_writes_node_statuses_and_scanned_tpdos() {
     // TPDO receive all: module 2's TPDO1 (6000h.1 and .2, its status bytes) arrives split by its
     // scanned mapping, once 5F01h.04 bit 2 is set.
     let tpdo = CanFrame::data(0x180 + u16::from(MEM), &[0x03, 0x40]).unwrap();
+    net.command(HostToDevice::WriteLocalRequest { index: 0x5F01, sub: 4, data: &0_u32.to_le_bytes() });
     net.bus.send(tpdo);
     net.collect();
     assert_eq!(net.indications(), [], "bit 2 clear: not received");
@@ -331,4 +333,51 @@ fn arbitrary_host_bytes_and_frames_never_panic_and_every_answer_is_a_whole_valid
     let after = net.answers();
     assert_eq!(after.len(), 11, "{after:?}");
     assert!(matches!(after[10], Out::U { err: 0, .. }), "{after:?}");
+}
+
+#[test]
+fn the_manager_keeps_nodes_operational_and_resets_a_lost_one() {
+    let mut net = Net::new(&[("canopenia", IA), ("co401memory1", MEM)]);
+    let node2 = |v: u8| d(IA, 0x5F04, MEM, &[v]);
+    // Node 2's statuses (its TPDOs are indicated too: PDO receive all is on).
+    let statuses = |net: &mut Net| net.indications().into_iter().filter(|o| matches!(o, Out::D { index: 0x5F04, .. })).collect::<Vec<_>>();
+    // The defaults (5F01h.04 = 087F0017h): the scan wrote 5F01h.05 (1000 ms) into the module's
+    // 1017h, KEEP_OP started it, and its heartbeats are monitored.
+    net.run_ms(1100);
+    let seen = statuses(&mut net);
+    assert!(seen.ends_with(&[node2(0xA0), node2(0x05), node2(0x90)]), "{seen:?}");
+    assert!(net.bus.log.iter().any(|(_, f)| f.id == 0 && f.data[..2] == [0x01, MEM]), "NMT start of node 2");
+    // A master stops it: its next heartbeat says so, and KEEP_OP starts it again.
+    net.bus.send(CanFrame::data(0, &[0x02, MEM]).unwrap());
+    net.run_ms(2100);
+    let seen = statuses(&mut net);
+    assert!(seen.windows(2).any(|w| w == [node2(0x04), node2(0x05)]), "{seen:?}");
+    // Its heartbeat stops (1017h = 0): lost after 1500 ms, reset; it boots, is scanned again
+    // (its 1017h written again) and started.
+    net.bus.send(CanFrame::data(0x600 + u16::from(MEM), &[0x2B, 0x17, 0x10, 0x00, 0, 0, 0, 0]).unwrap());
+    net.run_ms(3000);
+    let seen = statuses(&mut net);
+    let lost = seen.iter().position(|o| *o == node2(0x91)).unwrap_or_else(|| panic!("{seen:?}"));
+    assert_eq!(seen[lost..lost + 3], [node2(0x91), node2(0xB0), node2(0x00)], "{seen:?}");
+    assert!(seen[lost..].contains(&node2(0xA0)) && seen[lost..].contains(&node2(0x90)), "scanned and monitored again: {seen:?}");
+    // With KEEP_OP and HB receive all off nothing is restarted or reset.
+    net.command(HostToDevice::WriteLocalRequest { index: 0x5F01, sub: 4, data: &0_u32.to_le_bytes() });
+    net.bus.send(CanFrame::data(0, &[0x02, MEM]).unwrap());
+    net.run_ms(2100);
+    assert!(statuses(&mut net).contains(&node2(0x04)));
+    let starts = net.bus.log.iter().filter(|(t, f)| *t > net.bus.now_us() - 2_000_000 && f.id == 0 && f.data[0] == 0x01).count();
+    assert_eq!(starts, 0, "KEEP_OP off: the stopped node stays stopped");
+}
+
+#[test]
+fn autorun_starts_the_coprocessor_after_every_reset() {
+    let mut net = Net::new(&[("canopenia", IA)]);
+    let state = |v: u8| d(IA, 0x5F00, 2, &[v]);
+    assert!(net.indications().contains(&state(0x7F)), "AUTORUN low: pre-operational");
+    net.bus.nodes[0].console("autorun on").unwrap();
+    // A soft reset (5F01h.1 = 129) reads the pin again.
+    net.command(HostToDevice::WriteLocalRequest { index: 0x5F01, sub: 1, data: &[129] });
+    let seen = net.indications();
+    assert_eq!(seen, [d(IA, 0x5F00, 1, &[IA]), state(0x05), d(IA, 0x5F00, 3, &[0x01])], "the reset shows every status again");
+    assert!(net.bus.nodes[0].console("autorun maybe").is_err());
 }

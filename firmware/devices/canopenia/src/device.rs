@@ -21,6 +21,12 @@
 //! - **The manager's command entries**: 5F0Ah.1 sends an NMT master message, 5F01h.1 resets
 //!   the coprocessor (129: reset application, 130: reset communication), 5F01h.0Ah scans a
 //!   node again.
+//! - **Manager control** (5F01h.04, applied after every input): KEEP_OP starts a node whose
+//!   scan completed or whose heartbeat reports stopped or pre-operational; HB receive all
+//!   writes 5F01h.05 into scanned nodes' 1017h, monitors every node with 5F01h.06 and resets
+//!   a node whose heartbeat is lost; PDO receive all and use scanned entries as above.
+//! - **AUTORUN** (the pin, read at power-on): the coprocessor starts itself, after power-on
+//!   and after every reset.
 
 use crate::app::Typed;
 use crate::errors;
@@ -33,7 +39,8 @@ use coforge_link::{Deframer, Millis, Outbox};
 use coforge_stack::device::{Assemble, AssembleError, Device, HostPort, MemoryRequest, NodeAccess, assembly_mode, mode_names};
 use coforge_stack::frame::CanFrame;
 use coforge_stack::leds::Leds;
-use coforge_stack::manager::scan::{MAX_MAPPED, ScanConfig};
+use coforge_stack::manager::monitor::{MonitorEvent, NodeState};
+use coforge_stack::manager::scan::{MAX_MAPPED, ScanConfig, ScanEvent};
 use coforge_stack::manager::{Manager, ManagerEvent, nmt_frame};
 use coforge_stack::nmt::{NmtCommand, state_code};
 use coforge_stack::node::{BusState, NodeEvent};
@@ -52,6 +59,8 @@ const OUT: usize = 6 * MAX_FRAME;
 /// Node events kept for the runtime.
 const EVENTS: usize = 8;
 /// 5F01h.04 bits (manual section 9.2).
+const KEEP_OP: u32 = 1 << 0;
+const HB_RECEIVE_ALL: u32 = 1 << 1;
 const PDO_RECEIVE_ALL: u32 = 1 << 2;
 const USE_SCANNED: u32 = 1 << 4;
 /// 5F00h.03 bits this firmware can see: INIT, ERPA, TXOR, BOFF.
@@ -87,6 +96,13 @@ pub struct Canopenia<S> {
     /// 5F00h.03: what has happened since power-on.
     hardware: u8,
     events: Deque<NodeEvent, EVENTS>,
+    /// The AUTORUN pin: start operational without a master.
+    autorun: bool,
+    /// The time of the latest input.
+    now_us: u64,
+    /// The heartbeat times the manager was last given (5F01h.05/.06, or 0 with HB receive all
+    /// off).
+    heartbeat_ms: (u16, u16),
     /// Host frames that got no answer: a bad start byte, CRC or length, a letter the
     /// protocol does not have, or no room for the answer.
     pub host_refusals: u32,
@@ -108,9 +124,17 @@ impl<S: ParamStore> Canopenia<S> {
             shown: [0; 3],
             hardware: 0,
             events: Deque::new(),
+            autorun: false,
+            now_us: 0,
+            heartbeat_ms: (u16::MAX, u16::MAX),
             host_refusals: 0,
             indications_dropped: 0,
         }
+    }
+
+    /// The AUTORUN pin; read at power-on and at every reset of the coprocessor.
+    pub fn set_autorun(&mut self, high: bool) {
+        self.autorun = high;
     }
 
     pub fn node(&self) -> &Node<Typed<Coprocessor>, S> {
@@ -269,6 +293,7 @@ impl<S: ParamStore> Canopenia<S> {
 
     /// The end of every input: what the dictionary, the manager and the node have to say.
     fn after_input(&mut self, now_us: u64) {
+        self.now_us = self.now_us.max(now_us);
         while let Some(written) = self.node.od_mut().app.take_write() {
             self.on_written(&written, now_us);
         }
@@ -278,7 +303,34 @@ impl<S: ParamStore> Canopenia<S> {
             self.on_manager_event(&event);
         }
         self.take_node_events();
+        self.apply_manager_control();
         self.show_own_status();
+    }
+
+    /// The heartbeat times of 5F01h.05/.06 go to the manager when they (or HB receive all)
+    /// change: the producer time for scans to write into 1017h, the consumer time for every
+    /// node's monitoring.
+    fn apply_manager_control(&mut self) {
+        let control = &self.node.od().device_control;
+        let times = if control.manager_control & HB_RECEIVE_ALL != 0 {
+            (control.default_heartbeat_producer_time, control.default_heartbeat_consumer_time)
+        } else {
+            (0, 0)
+        };
+        if times == self.heartbeat_ms {
+            return;
+        }
+        self.heartbeat_ms = times;
+        let heartbeat_ms = (times.0 != 0).then_some(times.0);
+        self.manager.set_scan_config(ScanConfig { pdos: SCAN_PDOS as u8, heartbeat_ms });
+        self.manager.monitor_mut().set_consumer_ms(None, times.1);
+    }
+
+    /// The NMT command `command` to the coprocessor itself, as the bus would bring it.
+    fn own_nmt(&mut self, command: NmtCommand, now_us: u64) {
+        if let Some(frame) = nmt_frame(command, self.node.node_id()) {
+            self.node.on_frame(&frame, now_us);
+        }
     }
 
     /// A write the device acts on or tells the host of.
@@ -292,10 +344,7 @@ impl<S: ParamStore> Canopenia<S> {
             (index::NMT_MASTER_MESSAGE, 1) => self.nmt_master(lo, hi),
             (index::DEVICE_CONTROL, 1) => {
                 let command = if lo == 129 { NmtCommand::ResetNode } else { NmtCommand::ResetCommunication };
-                // The reset the coprocessor would get from the bus, addressed to itself.
-                if let Some(frame) = nmt_frame(command, self.node.node_id()) {
-                    self.node.on_frame(&frame, now_us);
-                }
+                self.own_nmt(command, now_us);
             }
             (index::DEVICE_CONTROL, 0x0A) => self.manager.scan(lo & 0x7F),
             _ => {}
@@ -331,6 +380,23 @@ impl<S: ParamStore> Canopenia<S> {
                 self.record_status(node, code);
             }
         }
+        let control = self.manager_control();
+        let not_operational = |state: NodeState| matches!(state, NodeState::Stopped | NodeState::PreOperational);
+        match *event {
+            ManagerEvent::Scan(ScanEvent::Complete(node)) if control & KEEP_OP != 0 => {
+                let operational = self.manager.status(node).is_some_and(|s| s.state == NodeState::Operational);
+                if !operational {
+                    self.manager.nmt(NmtCommand::Start, node);
+                }
+            }
+            ManagerEvent::Node(MonitorEvent::StateChanged { node, to: state, .. } | MonitorEvent::HeartbeatStarted { node, state })
+                if control & KEEP_OP != 0 && not_operational(state) =>
+            {
+                self.manager.nmt(NmtCommand::Start, node);
+            }
+            ManagerEvent::Node(MonitorEvent::HeartbeatLost(node)) if control & HB_RECEIVE_ALL != 0 => self.nmt_master(NmtCommand::ResetNode.code(), node),
+            _ => {}
+        }
     }
 
     /// 5F04h.`node` = `code`, and the host is told.
@@ -345,8 +411,13 @@ impl<S: ParamStore> Canopenia<S> {
     fn take_node_events(&mut self) {
         while let Some(event) = self.node.take_event() {
             if event == NodeEvent::ResetApplication || event == NodeEvent::ResetCommunication {
-                // The dictionary was reloaded: the status entries hold the defaults again.
+                // The dictionary was reloaded: the status entries and 5F01h hold their
+                // defaults again; AUTORUN starts the coprocessor again.
                 self.shown = [0xFF; 3];
+                self.heartbeat_ms = (u16::MAX, u16::MAX);
+                if self.autorun {
+                    self.own_nmt(NmtCommand::Start, self.now_us);
+                }
             }
             if self.events.is_full() {
                 self.events.pop_front();
@@ -402,9 +473,14 @@ impl<S: ParamStore> Canopenia<S> {
 
 impl<S: ParamStore> Device for Canopenia<S> {
     fn start(&mut self, now_us: u64) {
+        self.now_us = now_us;
         self.node.start(now_us);
         self.hardware = HW_INIT;
         self.shown = [0xFF; 3];
+        self.heartbeat_ms = (u16::MAX, u16::MAX);
+        if self.autorun {
+            self.own_nmt(NmtCommand::Start, now_us);
+        }
         self.after_input(now_us);
     }
 

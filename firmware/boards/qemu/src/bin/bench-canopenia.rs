@@ -59,16 +59,15 @@ fn host_bytes(chip: &mut Chip, bytes: &[u8]) {
     }
 }
 
-/// Node 3 answers the manager's scan: 1000h and 1018h.1..4 expedited, everything else (its
-/// PDO parameters) "object does not exist", which a scan takes as no PDO.
+/// Node 3 answers the manager's scan: 1000h and 1018h.1..4 expedited, the heartbeat time a
+/// scan writes (1017h) confirmed, everything else (its PDO parameters) "object does not
+/// exist", which a scan takes as no PDO. NMT frames (KEEP_OP starts the node) need no answer.
 fn scan_remote(chip: &mut Chip, first: Answers) {
-    let mut requests = first;
+    let mut answers = first;
     for _ in 0..64 {
-        let Some(request) = requests.get(0).copied() else { return };
-        if request.id != 0x600 + u16::from(REMOTE) {
-            fail("scan: a frame that is no SDO request to node 3", &requests);
-        }
-        let [_, lo, hi, sub, ..] = request.data;
+        let request = (0..answers.n.min(4)).filter_map(|i| answers.get(i)).find(|f| f.id == 0x600 + u16::from(REMOTE)).copied();
+        let Some(request) = request else { return };
+        let [command, lo, hi, sub, ..] = request.data;
         let value = match (u16::from_le_bytes([lo, hi]), sub) {
             (0x1000, 0) => Some(REMOTE_TYPE),
             (0x1018, 1) => Some(REMOTE_VENDOR),
@@ -76,15 +75,17 @@ fn scan_remote(chip: &mut Chip, first: Answers) {
             _ => None,
         };
         let response = match value {
+            // A download (the 1017h write): confirmed.
+            _ if command & 0xE0 == 0x20 => [0x60, lo, hi, sub, 0, 0, 0, 0],
             Some(v) => {
                 let [a, b, c, d] = v.to_le_bytes();
                 [0x43, lo, hi, sub, a, b, c, d]
             }
             None => [0x80, lo, hi, sub, 0x00, 0x00, 0x02, 0x06],
         };
-        requests = exchange(chip, &frame(0x580 + u16::from(REMOTE), &response), NOW_US);
+        answers = exchange(chip, &frame(0x580 + u16::from(REMOTE), &response), NOW_US);
     }
-    fail("scan: more than 64 transfers", &requests);
+    fail("scan: more than 64 transfers", &answers);
 }
 
 /// Builds the coprocessor right in a `MaybeUninit` static, in a frame of its own (see
