@@ -21,10 +21,9 @@ import time
 
 from bus import Recorder
 from simproc import SerialLine, SimProcess
-from test_e2e_memory1 import free_port
+from qemu import QemuProcess
 import canopen
 import pytest
-import re
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
@@ -158,49 +157,6 @@ def err_of(payload, at):
     return int.from_bytes(payload[at : at + 2], "little")
 
 
-class QemuProcess:
-    """The image in QEMU and a `coforge hub` on its UART1 (`stop` as simproc.SimProcess's)."""
-
-    def __init__(self, workdir):
-        assert pathlib.Path(IA_IMAGE).exists(), f"no QEMU image at {IA_IMAGE}: run `cargo xtask dist`"
-        serial_port, can_port = free_port(), free_port()
-        self.output = tempfile.TemporaryFile()
-        self.hub = None
-        self.qemu = subprocess.Popen(
-            ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", "none",
-             "-semihosting-config", "enable=on,target=native", "-kernel", IA_IMAGE,
-             *(arg for port in (serial_port, can_port) for arg in ("-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"))],
-            stdin=subprocess.DEVNULL, stdout=self.output, stderr=subprocess.STDOUT, cwd=workdir,
-        )
-        try:
-            self.hub = subprocess.Popen([COFORGE, "hub", "--port", "0", "--connect", f"127.0.0.1:{can_port}"], stdout=subprocess.PIPE, text=True)
-            hub = re.search(r"on slcan (socket://\S+)", self.hub.stdout.readline())
-            assert hub, f"coforge hub banner{self.output_note()}"
-            self.can_url = hub.group(1)
-            self.serial_url = f"socket://127.0.0.1:{serial_port}"
-        except BaseException:
-            self.stop()
-            raise
-
-    def output_note(self):
-        self.output.seek(0)
-        text = self.output.read().decode(errors="replace")
-        return f"; QEMU printed: {text}" if text else ""
-
-    def stop(self):
-        """Stops QEMU and the hub; fails if QEMU had exited by itself (a panic), with its output."""
-        exited = self.qemu.poll()
-        for proc in (self.hub, self.qemu):
-            if proc is not None:
-                proc.kill()
-                proc.wait(timeout=10)
-        if self.hub is not None:
-            self.hub.stdout.close()
-        note = self.output_note()
-        self.output.close()
-        assert exited is None, f"QEMU exited by itself with {exited}{note}"
-
-
 class Target:
     """A running coprocessor, `kind` "sim" or "qemu", with python-canopen and the host."""
 
@@ -209,7 +165,7 @@ class Target:
         if kind == "sim":
             self.sim = SimProcess([COFORGE, "sim", "canopenia", "--node-id", str(NODE_ID), "--port", "0", "--serial", "0"])
         else:
-            self.sim = QemuProcess(workdir)
+            self.sim = QemuProcess(IA_IMAGE, workdir)
         try:
             if kind == "sim":
                 serial_url = self.sim.banner(r"serial host on (socket://\S+)")

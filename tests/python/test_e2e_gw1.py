@@ -23,15 +23,14 @@ import os
 import pathlib
 import re
 import socket
-import subprocess
-import tempfile
 import time
 
 import pytest
 from canopen.sdo.exceptions import SdoCommunicationError
 
 from bus import Recorder
-from test_e2e_memory1 import COFORGE, ROOT, connect, free_port
+import qemu
+from test_e2e_memory1 import ROOT, connect
 from test_gw1 import EMY0_EMCY, NODE_ID, PRE_OPERATIONAL, SDO_TIMEOUT, WAIT, Host, Sim, X, dictionary, eventually, h
 import canopen
 
@@ -42,38 +41,20 @@ SAVE = 0x65766173  # "save", 1010h.1
 BOOTUP_FRAME = b"\x00"
 
 
-class QemuProcess:
+class QemuProcess(qemu.QemuProcess):
     """The GW1 image in QEMU and a `coforge hub` on its UART1, with the interface of
     simproc.SimProcess that `Sim` uses (`console`, `stop`): the console is UART2's."""
 
     def __init__(self, workdir):
-        assert pathlib.Path(GW1_IMAGE).exists(), f"no QEMU image at {GW1_IMAGE}: run `cargo xtask dist`"
-        serial_port, can_port, pins_port = free_port(), free_port(), free_port()
-        self.output = tempfile.TemporaryFile()
-        self.hub = self.pins = None
+        self.pins = None
         self.pending = b""
-        self.qemu = subprocess.Popen(
-            ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", "none",
-             "-semihosting-config", "enable=on,target=native", "-kernel", GW1_IMAGE,
-             *(arg for port in (serial_port, can_port, pins_port) for arg in ("-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"))],
-            stdin=subprocess.DEVNULL, stdout=self.output, stderr=subprocess.STDOUT, cwd=workdir,
-        )
+        super().__init__(GW1_IMAGE, workdir, uarts=3)
         try:
-            self.hub = subprocess.Popen([COFORGE, "hub", "--port", "0", "--connect", f"127.0.0.1:{can_port}"], stdout=subprocess.PIPE, text=True)
-            hub = re.search(r"on slcan (socket://\S+)", self.hub.stdout.readline())
-            assert hub, f"coforge hub banner{self.output_note()}"
-            self.can_url = hub.group(1)
-            self.serial_url = f"socket://127.0.0.1:{serial_port}"
-            self.pins = connect(pins_port)
+            self.pins = connect(self.ports[2])
             self.pins.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         except BaseException:
             self.stop()
             raise
-
-    def output_note(self):
-        self.output.seek(0)
-        text = self.output.read().decode(errors="replace")
-        return f"; QEMU printed: {text}" if text else ""
 
     def answer(self, command, timeout=5.0):
         """Sends a console line; the answer line, without its "\\n"."""
@@ -99,19 +80,9 @@ class QemuProcess:
         return line[len("ok ") :]
 
     def stop(self):
-        """Stops QEMU and the hub; fails if QEMU had exited by itself (a panic), with its output."""
-        exited = self.qemu.poll()
         if self.pins is not None:
             self.pins.close()
-        for proc in (self.hub, self.qemu):
-            if proc is not None:
-                proc.kill()
-                proc.wait(timeout=10)
-        if self.hub is not None:
-            self.hub.stdout.close()
-        note = self.output_note()
-        self.output.close()
-        assert exited is None, f"QEMU exited by itself with {exited}{note}"
+        super().stop()
 
 
 class Target(Sim):
