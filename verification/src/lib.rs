@@ -12,8 +12,10 @@
 #![forbid(unsafe_code)]
 
 pub mod banks;
+pub mod canopenia;
 pub mod framing;
 pub mod gw1;
+pub mod inputs;
 pub mod integrity;
 pub mod manager;
 pub mod node;

@@ -186,7 +186,8 @@ fn test() -> Result {
 }
 
 /// The fuzz targets in `verification/fuzz` (one per streaming decoder).
-const FUZZ_TARGETS: &[&str] = &["nibble_decoder", "length_byte_decoder", "start_crc_decoder", "node_frames", "gw1_inputs", "manager_inputs"];
+const FUZZ_TARGETS: &[&str] =
+    &["nibble_decoder", "length_byte_decoder", "start_crc_decoder", "node_frames", "gw1_inputs", "manager_inputs", "canopenia_inputs"];
 
 /// Runs each fuzz target for `FUZZ_SECONDS` (default 20) seconds; a crash fails the run.
 fn fuzz() -> Result {
