@@ -142,6 +142,11 @@ enum Cmd {
         /// Run this many nodes, with node-IDs node_id, node_id + 1, ...
         #[arg(long, default_value_t = 1)]
         nodes: u8,
+        /// Put this hub's bus on another SLCAN bus at HOST:PORT (another `coforge sim` or
+        /// `coforge hub`, or an image's SLCAN UART), so devices of different kinds share one
+        /// bus; repeatable.
+        #[arg(long)]
+        connect: Vec<String>,
         /// Stop after this many seconds (default: run until killed).
         #[arg(long)]
         seconds: Option<u64>,
@@ -223,13 +228,14 @@ struct SimArgs<'a> {
     mode: Option<&'a str>,
     store: Option<PathBuf>,
     count: u8,
+    connect: &'a [String],
     seconds: Option<u64>,
     serial: Option<u16>,
     enable_can: bool,
 }
 
 fn sim(args: SimArgs<'_>) -> Result<ExitCode, String> {
-    let SimArgs { device, first_id, port, mode, store, count, seconds, serial, enable_can } = args;
+    let SimArgs { device, first_id, port, mode, store, count, connect, seconds, serial, enable_can } = args;
     use coforge_sim::devices::{DeviceKind, StoreAt};
     let kind = DeviceKind::find(device)?;
     if count == 0 || u16::from(first_id) + u16::from(count) - 1 > 127 {
@@ -241,6 +247,7 @@ fn sim(args: SimArgs<'_>) -> Result<ExitCode, String> {
     let at = store.map_or(StoreAt::Memory, StoreAt::File);
     let mut nodes = (first_id..first_id + count).map(|id| kind.create(mode, id, &at)).collect::<Result<Vec<_>, _>>()?;
     let hub = coforge_sim::hub::Hub::bind(("127.0.0.1", port)).map_err(|e| format!("cannot listen on port {port}: {e}"))?;
+    connect_all(&hub, connect)?;
     let has_serial = nodes.first_mut().is_some_and(|n| n.host_port().is_some());
     let running = coforge_sim::runner::spawn(&hub, nodes);
     if enable_can {
@@ -318,8 +325,8 @@ fn console(running: &coforge_sim::runner::Running, deadline: Option<std::time::I
     }
 }
 
-fn hub(port: u16, adapters: &[String], seconds: Option<u64>) -> Result<ExitCode, String> {
-    let hub = coforge_sim::hub::Hub::bind(("127.0.0.1", port)).map_err(|e| format!("cannot listen on port {port}: {e}"))?;
+/// Puts `hub`'s bus on each SLCAN bus in `adapters` (HOST:PORT).
+fn connect_all(hub: &coforge_sim::hub::Hub, adapters: &[String]) -> Result<(), String> {
     for addr in adapters {
         // An emulator may still be starting: give its UART a few seconds to listen.
         let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
@@ -330,6 +337,12 @@ fn hub(port: u16, adapters: &[String], seconds: Option<u64>) -> Result<ExitCode,
             std::thread::sleep(std::time::Duration::from_millis(50));
         }
     }
+    Ok(())
+}
+
+fn hub(port: u16, adapters: &[String], seconds: Option<u64>) -> Result<ExitCode, String> {
+    let hub = coforge_sim::hub::Hub::bind(("127.0.0.1", port)).map_err(|e| format!("cannot listen on port {port}: {e}"))?;
+    connect_all(&hub, adapters)?;
     println!("coforge hub: {} adapter(s) on slcan socket://{}", adapters.len(), hub.local_addr());
     use std::io::Write as _;
     let _ = std::io::stdout().flush();
@@ -346,8 +359,8 @@ fn run(cmd: Cmd) -> Result<ExitCode, String> {
     match cmd {
         Cmd::Hub { port, connect, seconds } => hub(port, &connect, seconds),
         Cmd::Master { port, timeout_ms, cmd } => master::run(&port, timeout_ms, cmd),
-        Cmd::Sim { device, node_id, port, mode, store, nodes, seconds, serial, enable_can } => {
-            sim(SimArgs { device: &device, first_id: node_id, port, mode: mode.as_deref(), store, count: nodes, seconds, serial, enable_can })
+        Cmd::Sim { device, node_id, port, mode, store, nodes, connect, seconds, serial, enable_can } => {
+            sim(SimArgs { device: &device, first_id: node_id, port, mode: mode.as_deref(), store, count: nodes, connect: &connect, seconds, serial, enable_can })
         }
         Cmd::Check { specs } => {
             let mut failed = 0;

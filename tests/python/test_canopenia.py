@@ -170,8 +170,10 @@ class Target:
             if kind == "sim":
                 serial_url = self.sim.banner(r"serial host on (socket://\S+)")
                 can_url = self.sim.banner(rf"canopenia node-ID {NODE_ID} on slcan (socket://\S+)")
+                self.sim_can_url = can_url
             else:
                 serial_url, can_url = self.sim.serial_url, self.sim.can_url
+            self.sim_can_url = can_url
             with tempfile.TemporaryDirectory() as d:
                 eds = pathlib.Path(d) / "canopenia.eds"
                 subprocess.run([COFORGE, "eds", SPEC, "-o", eds], check=True, timeout=60)
@@ -287,3 +289,74 @@ def test_writes_from_the_bus_and_state_changes_are_indicated(sim):
     sim.host.xfer(b"W\x00\x62\x01\x07")
     sim.host.silent(0.3)
     assert bytes.fromhex("44 00 00 62 01 07") not in sim.host.indications
+
+
+# --------------------------------------------------------------------------------------------
+# The coprocessor as the manager of a bus: CO401Memory1 (node 3) and CO401GW1 (node 5) boot
+# after it, each in a `coforge sim` of its own whose bus is put on the coprocessor's with
+# `--connect`. The defaults of 5F01h.04 (087F0017h, erratum COIA-48) scan them, start them and
+# monitor their heartbeats; the host sees all of it as indications D.
+# --------------------------------------------------------------------------------------------
+
+MEM_ID, GW1_ID = 3, 5
+
+
+def status(node, code):
+    """D of 5F04h.`node` (NODESTATUS `code`), sent with the coprocessor's node-ID."""
+    return bytes([0x44, NODE_ID, 0x04, 0x5F, node, code])
+
+
+@pytest.fixture
+def bus():
+    ia = Target("sim", None)
+    others = []
+    try:
+        hub = ia.sim_can_url.removeprefix("socket://")
+
+        def boot(args, node):
+            proc = SimProcess([COFORGE, "sim", *args, "--node-id", str(node), "--port", "0", "--connect", hub])
+            proc.banner(rf"node-ID {node} on slcan (socket://\S+)")
+            others.append(proc)
+            return proc
+
+        yield ia, boot
+    finally:
+        for proc in others:
+            if proc.proc.poll() is None:
+                proc.stop()
+        ia.close()
+
+
+def test_the_manager_scans_starts_and_monitors_the_nodes_that_boot(bus):
+    ia, boot = bus
+    host = ia.host
+    mem = boot(["co401memory1"], MEM_ID)
+    # Boot-up, scan started, scan complete, started (KEEP_OP), heartbeat active: in this order
+    # (the module also reports its blank banks with emergencies, 80h, during the scan).
+    for code in (0x00, 0x9F, 0xA0, 0x05, 0x90):
+        host.indication(status(MEM_ID, code), timeout=5.0)
+    order = [i[5] for i in host.indications if i[:5] == status(MEM_ID, 0)[:5]]
+    assert [c for c in order if c != 0x80][:5] == [0x00, 0x9F, 0xA0, 0x05, 0x90], order
+    gw1 = boot(["co401gw1", "--enable-can"], GW1_ID)
+    for code in (0x00, 0x9F, 0xA0, 0x05, 0x90):
+        host.indication(status(GW1_ID, code), timeout=5.0)
+
+    # U of the gateway's 1000h comes from the scan cache; S of 6200h.1 reaches its outputs.
+    start, payload = host.xfer(bytes([0x55, GW1_ID, 0x00, 0x10, 0x00]))
+    assert err_of(payload, 5) == 0 and int.from_bytes(payload[7:11], "little") == 0x000F0191
+    start, payload = host.xfer(bytes([0x53, GW1_ID, 0x00, 0x62, 0x01, 0x5A]))
+    assert err_of(payload, 5) == 0
+    assert gw1.console("pins").startswith("outputs 0x5a")
+
+    # TPDO receive all: the gateway's input IN0 arrives as D of its 6000h.1, from node 5.
+    gw1.console("in 1")
+    host.indication(bytes([0x44, GW1_ID, 0x00, 0x60, 0x01, 0x01]), timeout=5.0)
+
+    # Without KEEP_OP, an NMT stop through 5F0Ah stops the module; its heartbeat says so.
+    assert err_of(host.xfer(b"W\x01\x5f\x04" + (0x087F0016).to_bytes(4, "little"))[1], 4) == 0
+    assert err_of(host.xfer(bytes([0x57, 0x0A, 0x5F, 0x01, 0x02, MEM_ID]))[1], 4) == 0
+    host.indication(status(MEM_ID, 0x04), timeout=3.0)
+    # The module goes away: its heartbeat is lost after 1.5 s, and the manager resets it.
+    mem.stop()
+    host.indication(status(MEM_ID, 0x91), timeout=4.0)
+    host.indication(status(MEM_ID, 0xB0), timeout=1.0)
