@@ -359,9 +359,18 @@ fn run(cmd: Cmd) -> Result<ExitCode, String> {
     match cmd {
         Cmd::Hub { port, connect, seconds } => hub(port, &connect, seconds),
         Cmd::Master { port, timeout_ms, cmd } => master::run(&port, timeout_ms, cmd),
-        Cmd::Sim { device, node_id, port, mode, store, nodes, connect, seconds, serial, enable_can } => {
-            sim(SimArgs { device: &device, first_id: node_id, port, mode: mode.as_deref(), store, count: nodes, connect: &connect, seconds, serial, enable_can })
-        }
+        Cmd::Sim { device, node_id, port, mode, store, nodes, connect, seconds, serial, enable_can } => sim(SimArgs {
+            device: &device,
+            first_id: node_id,
+            port,
+            mode: mode.as_deref(),
+            store,
+            count: nodes,
+            connect: &connect,
+            seconds,
+            serial,
+            enable_can,
+        }),
         Cmd::Check { specs } => {
             let mut failed = 0;
             for path in &specs {
