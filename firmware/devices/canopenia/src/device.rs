@@ -126,6 +126,7 @@ impl<S: ParamStore> Canopenia<S> {
             events: Deque::new(),
             autorun: false,
             now_us: 0,
+            // No times given yet: the first input gives them.
             heartbeat_ms: (u16::MAX, u16::MAX),
             host_refusals: 0,
             indications_dropped: 0,
@@ -411,10 +412,10 @@ impl<S: ParamStore> Canopenia<S> {
     fn take_node_events(&mut self) {
         while let Some(event) = self.node.take_event() {
             if event == NodeEvent::ResetApplication || event == NodeEvent::ResetCommunication {
-                // The dictionary was reloaded: the status entries and 5F01h hold their
-                // defaults again; AUTORUN starts the coprocessor again.
+                // The dictionary was reloaded: the status entries hold their defaults again
+                // (5F01h's are compared with what the manager has after this input); AUTORUN
+                // starts the coprocessor again.
                 self.shown = [0xFF; 3];
-                self.heartbeat_ms = (u16::MAX, u16::MAX);
                 if self.autorun {
                     self.own_nmt(NmtCommand::Start, self.now_us);
                 }
@@ -477,7 +478,6 @@ impl<S: ParamStore> Device for Canopenia<S> {
         self.node.start(now_us);
         self.hardware = HW_INIT;
         self.shown = [0xFF; 3];
-        self.heartbeat_ms = (u16::MAX, u16::MAX);
         if self.autorun {
             self.own_nmt(NmtCommand::Start, now_us);
         }

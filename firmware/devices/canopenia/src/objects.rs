@@ -28,8 +28,12 @@ pub struct Written {
 impl Written {
     /// Whether the host is told of it: it came from the bus.
     pub fn from_bus(&self) -> bool {
-        matches!(self.by, WriteSource::Sdo | WriteSource::Rpdo)
+        from_bus(self.by)
     }
+}
+
+fn from_bus(by: WriteSource) -> bool {
+    matches!(by, WriteSource::Sdo | WriteSource::Rpdo)
 }
 
 /// Whether the device acts on writes of this entry, whoever writes it.
@@ -64,8 +68,7 @@ impl Hooks for Coprocessor {
     }
 
     fn written(&mut self, index: u16, sub: u8, data: &[u8], by: WriteSource) {
-        let from_bus = matches!(by, WriteSource::Sdo | WriteSource::Rpdo);
-        if !from_bus && !is_command_entry(index, sub) {
+        if !from_bus(by) && !is_command_entry(index, sub) {
             return;
         }
         let kept = heapless::Vec::from_slice(data).ok().is_some_and(|data| self.writes.push_back(Written { index, sub, data, by }).is_ok());
