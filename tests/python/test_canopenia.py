@@ -229,7 +229,7 @@ def test_the_manuals_local_examples_byte_for_byte(sim):
     assert host.raw_xfer(encode(b"R\x00\x5F\x01")) == bytes.fromhex("11 07 52 00 5F 01 00 00 02 51 6B")
     # 1000h, the device type of the spec.
     start, payload = host.xfer(bytes.fromhex("52 00 10 00"))
-    assert payload == b"R\x00\x10\x00\x00\x00" + (0x00030191).to_bytes(4, "little")
+    assert payload == b"R\x00\x10\x00\x00\x00" + (0x000F0191).to_bytes(4, "little")
 
 
 def test_error_bits_start_byte_options_and_resync(sim):
@@ -273,7 +273,7 @@ def test_remote_operations_busy_and_timeout(sim):
     assert err_of(host.xfer(b"U\x80\x00\x10\x00")[1], 5) == BIT_INVALID
     # Its own node-ID: served from its own dictionary.
     start, payload = host.xfer(bytes([0x55, NODE_ID, 0x00, 0x10, 0x00]))
-    assert err_of(payload, 5) == 0 and payload[7:] == (0x00030191).to_bytes(4, "little")
+    assert err_of(payload, 5) == 0 and payload[7:] == (0x000F0191).to_bytes(4, "little")
 
 
 def test_writes_from_the_bus_and_state_changes_are_indicated(sim):

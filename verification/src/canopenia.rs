@@ -24,7 +24,9 @@ pub use crate::inputs::Input;
 
 /// The coprocessor's node-ID.
 pub const NODE: u16 = 2;
-const MAINTAINED: [u16; 3] = [0x1001, 0x5F00, 0x5F04];
+/// Entries the device keeps itself: the error register, the error history (each emergency it
+/// sends), its status (5F00h) and every node's (5F04h).
+const MAINTAINED: [u16; 4] = [0x1001, 0x1003, 0x5F00, 0x5F04];
 
 type Chip = Canopenia<NoStore>;
 

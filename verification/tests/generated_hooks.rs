@@ -29,6 +29,14 @@ impl Hooks for Loader {
         Ok(())
     }
 
+    fn read_program_control(&mut self, _: u8) -> Result<u8, SdoAbort> {
+        Ok(1)
+    }
+
+    fn write_program_control(&mut self, _: u8, _: u8) -> Result<(), SdoAbort> {
+        Ok(())
+    }
+
     fn written(&mut self, index: u16, sub: u8, data: &[u8], by: WriteSource) {
         self.written.push((index, sub, data.len(), by));
     }

@@ -8,7 +8,7 @@ use crate::storage::Eeprom;
 use canopenia::Canopenia;
 use coforge_stack::store::BlockStore;
 
-impl Console for Canopenia<BlockStore<Eeprom>> {
+impl Console for Canopenia<BlockStore<Eeprom>, Eeprom> {
     fn console(&mut self, command: &str) -> Result<String, String> {
         match command.split_whitespace().collect::<Vec<_>>().as_slice() {
             ["autorun", level @ ("on" | "off")] => {

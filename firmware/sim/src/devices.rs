@@ -17,7 +17,7 @@ pub const DEVICES: &[DeviceKind] = &[
     DeviceKind::of::<Memory1<Eeprom, FixedBoard>>("co401memory1"),
     DeviceKind::of::<Gw1<co401gw1::FixedBoard, BlockStore<Eeprom>>>("co401gw1"),
     DeviceKind::of::<cr3101::Node<RamApp, BlockStore<Eeprom>>>("cr3101"),
-    DeviceKind::of::<canopenia::Canopenia<BlockStore<Eeprom>>>("canopenia"),
+    DeviceKind::of::<canopenia::Canopenia<BlockStore<Eeprom>, Eeprom>>("canopenia"),
 ];
 
 /// Fault-injection commands typed on the simulator's console (see `coforge sim --help`).

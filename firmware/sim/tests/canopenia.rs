@@ -128,7 +128,7 @@ fn local_reads_and_writes_with_their_error_bits() {
     assert_eq!(
         net.answers(),
         [
-            Out::R { index: 0x1000, sub: 0, err: 0, data: 0x0003_0191_u32.to_le_bytes().to_vec() },
+            Out::R { index: 0x1000, sub: 0, err: 0, data: 0x000F_0191_u32.to_le_bytes().to_vec() },
             Out::W { index: 0x6000, sub: 1, err: 0 },
             Out::R { index: 0x6000, sub: 1, err: 0, data: vec![0x5A] },
             Out::R { index: 0x2345, sub: 0, err: 1 << 0, data: vec![] },
@@ -222,7 +222,7 @@ fn remote_reads_and_writes_through_the_manager_one_at_a_time() {
     );
     // Its own node-ID: served from its own dictionary, with the bus's rules.
     net.command(HostToDevice::ReadRemoteRequest { node_id: IA, index: 0x1000, sub: 0 });
-    assert_eq!(net.answers(), [Out::U { node: IA, index: 0x1000, sub: 0, err: 0, data: 0x0003_0191_u32.to_le_bytes().to_vec() }]);
+    assert_eq!(net.answers(), [Out::U { node: IA, index: 0x1000, sub: 0, err: 0, data: 0x000F_0191_u32.to_le_bytes().to_vec() }]);
 }
 
 #[test]

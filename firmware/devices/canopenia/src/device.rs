@@ -25,10 +25,19 @@
 //!   scan completed or whose heartbeat reports stopped or pre-operational; HB receive all
 //!   writes 5F01h.05 into scanned nodes' 1017h, monitors every node with 5F01h.06 and resets
 //!   a node whose heartbeat is lost; PDO receive all and use scanned entries as above.
-//! - **AUTORUN** (the pin, read at power-on): the coprocessor starts itself, after power-on
-//!   and after every reset.
+//! - **AUTORUN** (the pin, read at power-on) or a loaded file's autostart: the coprocessor
+//!   starts itself, after power-on and after every reset.
+//! - **Configuration loading** ([`crate::config`]): the activation sequence puts the
+//!   coprocessor into bootloader mode as node 70h (its manager and autostart off); 1F51h.1 = 1
+//!   starts the application again, confirmed by an error-reset emergency from node 70h (as the
+//!   manual's trace shows, erratum COIA-52). The active file sets the node-ID, whether the
+//!   manager runs (FUNC bit 3), autostart (bit 1) and the NMT start of every node (bit 2), and
+//!   its values are written after every initialisation, before what 1010h saved.
 
 use crate::app::Typed;
+use crate::config::program::ProgramRequest;
+use crate::config::slots::{FILE_MAX, NoMemory};
+use crate::config::{Settings, apply};
 use crate::errors;
 use crate::host::{self, Command, MAX_VALUE, Request};
 use crate::objects::{Coprocessor, Written};
@@ -44,9 +53,10 @@ use coforge_stack::manager::scan::{MAX_MAPPED, ScanConfig, ScanEvent};
 use coforge_stack::manager::{Manager, ManagerEvent, nmt_frame};
 use coforge_stack::nmt::{NmtCommand, state_code};
 use coforge_stack::node::{BusState, NodeEvent};
-use coforge_stack::od::{NodeDictionary, Side};
+use coforge_stack::od::{Area, NodeDictionary, Side};
 use coforge_stack::sdo::client::{SdoResult, StartError};
 use coforge_stack::store::{BlockStore, ParamStore};
+use embedded_storage::Storage;
 use heapless::Deque;
 
 /// Scans the manager keeps (node records, each with this many PDOs each way).
@@ -68,6 +78,8 @@ const HW_INIT: u8 = 1 << 0;
 const HW_ERROR_PASSIVE: u8 = 1 << 2;
 const HW_TX_OVERRUN: u8 = 1 << 4;
 const HW_BUS_OFF: u8 = 1 << 7;
+/// The node-ID of bootloader mode (manual section 4.2).
+pub const BOOTLOADER_NODE_ID: u8 = 0x70;
 
 /// The remote operation the SDO client runs for the host, and its command's start byte.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -79,10 +91,11 @@ struct Remote {
     start: u8,
 }
 
-/// The CANopenIA coprocessor with parameter store `S` (1010h/1011h).
+/// The CANopenIA coprocessor with parameter store `S` (1010h/1011h) and configuration memory
+/// `M` (two binary EDS slots; [`NoMemory`]: none, files cannot be loaded).
 #[derive(Debug)]
-pub struct Canopenia<S> {
-    node: Node<Typed<Coprocessor>, S>,
+pub struct Canopenia<S, M = NoMemory> {
+    node: Node<Typed<Coprocessor<M>>, S>,
     manager: Manager<SCANS, SCAN_PDOS>,
     host: serial::Decoder,
     out: Outbox<OUT>,
@@ -98,6 +111,13 @@ pub struct Canopenia<S> {
     events: Deque<NodeEvent, EVENTS>,
     /// The AUTORUN pin: start operational without a master.
     autorun: bool,
+    /// The node-ID the runtime gives (pins, board): used when no file sets one.
+    hardware_node_id: u8,
+    /// What the active configuration file sets besides dictionary values.
+    settings: Settings,
+    /// A change of program 1F50h/1F51h asked for, carried out once the node's answer left
+    /// (a reset empties the transmit queue).
+    program_change: Option<ProgramRequest>,
     /// The time of the latest input.
     now_us: u64,
     /// The heartbeat times the manager was last given (5F01h.05/.06, or 0 with HB receive all
@@ -108,13 +128,29 @@ pub struct Canopenia<S> {
     pub host_refusals: u32,
     /// Indications not sent: no room, or a value longer than an indication carries.
     pub indications_dropped: u32,
+    /// Values of the active file the dictionary refused when they were applied (none for a
+    /// file that passed the check; counted, not expected).
+    pub config_write_errors: u32,
 }
 
-impl<S: ParamStore> Canopenia<S> {
+impl<S: ParamStore> Canopenia<S, NoMemory> {
+    /// A coprocessor without configuration memory: it runs the firmware's own dictionary.
     pub fn new(node_id: u8, store: S) -> Self {
-        let od = Od::new(Mode::Default, node_id, Typed(Coprocessor::default()));
+        Canopenia::with_configuration(node_id, store, NoMemory)
+    }
+}
+
+impl<S: ParamStore, M: Storage> Canopenia<S, M> {
+    /// A coprocessor whose configuration files live in `memory` (at least
+    /// [`ConfigSlots::CAPACITY`](crate::config::slots::ConfigSlots::CAPACITY) bytes); the
+    /// active file's node-ID, if it sets one, replaces `node_id`.
+    pub fn with_configuration(node_id: u8, store: S, memory: M) -> Self {
+        let mut app = Coprocessor::new(memory);
+        let settings = settings_of(&mut app);
+        let own_id = settings.node_id.unwrap_or(node_id);
+        let od = Od::new(Mode::Default, own_id, Typed(app));
         Canopenia {
-            node: Node::new(od, store, crate::node_config(node_id)),
+            node: Node::new(od, store, crate::node_config(own_id)),
             manager: Manager::new(ScanConfig { pdos: SCAN_PDOS as u8, heartbeat_ms: None }),
             host: serial::decoder(),
             out: Outbox::default(),
@@ -125,12 +161,91 @@ impl<S: ParamStore> Canopenia<S> {
             hardware: 0,
             events: Deque::new(),
             autorun: false,
+            hardware_node_id: node_id,
+            settings,
+            program_change: None,
             now_us: 0,
             // No times given yet: the first input gives them.
             heartbeat_ms: (u16::MAX, u16::MAX),
             host_refusals: 0,
             indications_dropped: 0,
+            config_write_errors: 0,
         }
+    }
+
+    /// What the active configuration sets (the firmware's own settings without one).
+    pub fn settings(&self) -> Settings {
+        self.settings
+    }
+
+    /// Whether the coprocessor is in bootloader mode.
+    pub fn in_bootloader(&self) -> bool {
+        self.node.od().app.program.in_bootloader()
+    }
+
+    /// The manager runs in the application, unless the active file turns it off.
+    fn manager_runs(&self) -> bool {
+        self.settings.manager && !self.in_bootloader()
+    }
+
+    /// AUTORUN or the file's autostart; never in bootloader mode.
+    fn autostart(&self) -> bool {
+        (self.autorun || self.settings.autostart) && !self.in_bootloader()
+    }
+
+    /// After power-on or a reset: the coprocessor starts itself, and as boot-up manager starts
+    /// every node.
+    fn after_boot(&mut self, now_us: u64) {
+        if self.autostart() {
+            self.own_nmt(NmtCommand::Start, now_us);
+        }
+        if self.settings.nmt_master && self.manager_runs() {
+            self.manager.nmt(NmtCommand::Start, 0);
+        }
+    }
+
+    /// The active file's values for `area`, then what 1010h saved over them.
+    fn apply_configuration(&mut self, area: Area) {
+        if self.in_bootloader() {
+            return;
+        }
+        let mut buf = [0_u8; FILE_MAX];
+        let Some(file) = self.node.od_mut().app.program.active(&mut buf) else { return };
+        let node_id = self.node.node_id();
+        let mut failed = 0_u32;
+        let node = &mut self.node;
+        apply::apply(&file, crate::od::entries(Mode::Default), area, node_id, &mut |index, sub, data| {
+            if node.write(index, sub, data, Side::Device).is_err() {
+                failed += 1;
+            }
+        });
+        self.node.reload_stored(area);
+        self.config_write_errors = self.config_write_errors.saturating_add(failed);
+    }
+
+    /// 1F50h/1F51h asked for another program and the node's frames have left: the
+    /// coprocessor resets into it.
+    fn change_program(&mut self, request: ProgramRequest, now_us: u64) {
+        match request {
+            ProgramRequest::EnterBootloader => {
+                self.node.od_mut().app.program.entered(true);
+                self.node.set_node_id(BOOTLOADER_NODE_ID);
+            }
+            ProgramRequest::StartApplication => {
+                // The bootloader confirms the start with an error-reset emergency (section
+                // 4.2's trace), from its own node-ID; the reset waits until it has left.
+                if let Some(frame) = CanFrame::data(0x80 + u16::from(self.node.node_id()), &[0; 8]) {
+                    self.node.send_frame(frame);
+                }
+                self.node.od_mut().app.program.entered(false);
+                self.settings = settings_of(&mut self.node.od_mut().app);
+                self.node.set_node_id(self.settings.node_id.unwrap_or(self.hardware_node_id));
+                self.program_change = Some(ProgramRequest::Restart);
+                return;
+            }
+            ProgramRequest::Restart => {}
+        }
+        self.own_nmt(NmtCommand::ResetNode, now_us);
     }
 
     /// The AUTORUN pin; read at power-on and at every reset of the coprocessor.
@@ -138,11 +253,11 @@ impl<S: ParamStore> Canopenia<S> {
         self.autorun = high;
     }
 
-    pub fn node(&self) -> &Node<Typed<Coprocessor>, S> {
+    pub fn node(&self) -> &Node<Typed<Coprocessor<M>>, S> {
         &self.node
     }
 
-    pub fn node_mut(&mut self) -> &mut Node<Typed<Coprocessor>, S> {
+    pub fn node_mut(&mut self) -> &mut Node<Typed<Coprocessor<M>>, S> {
         &mut self.node
     }
 
@@ -256,7 +371,10 @@ impl<S: ParamStore> Canopenia<S> {
 
     /// Why S or U to `node` cannot start now.
     fn remote_refusal(&self, node: u8) -> Option<u16> {
-        if self.remote.is_some() {
+        if !self.manager_runs() {
+            // Bootloader mode, or a file without the CANopen manager.
+            Some(serial::errors::NOT_SUPPORTED)
+        } else if self.remote.is_some() {
             Some(serial::errors::BUSY)
         } else if !(1..=127).contains(&node) {
             Some(serial::errors::INVALID_COMMAND)
@@ -297,6 +415,9 @@ impl<S: ParamStore> Canopenia<S> {
         self.now_us = self.now_us.max(now_us);
         while let Some(written) = self.node.od_mut().app.take_write() {
             self.on_written(&written, now_us);
+        }
+        if let Some(request) = self.node.od_mut().app.program.take_request() {
+            self.program_change = Some(request);
         }
         let dropped = core::mem::take(&mut self.node.od_mut().app.writes_dropped);
         self.indications_dropped = self.indications_dropped.saturating_add(dropped);
@@ -411,14 +532,18 @@ impl<S: ParamStore> Canopenia<S> {
 
     fn take_node_events(&mut self) {
         while let Some(event) = self.node.take_event() {
-            if event == NodeEvent::ResetApplication || event == NodeEvent::ResetCommunication {
-                // The dictionary was reloaded: the status entries hold their defaults again
-                // (5F01h's are compared with what the manager has after this input); AUTORUN
-                // starts the coprocessor again.
+            let area = match event {
+                NodeEvent::ResetApplication => Some(Area::ALL),
+                NodeEvent::ResetCommunication => Some(Area::COMMUNICATION),
+                _ => None,
+            };
+            if let Some(area) = area {
+                // The dictionary was reloaded: the loaded file's values again, the status
+                // entries hold their defaults again (5F01h's are compared with what the
+                // manager has after this input); the coprocessor starts itself again.
+                self.apply_configuration(area);
                 self.shown = [0xFF; 3];
-                if self.autorun {
-                    self.own_nmt(NmtCommand::Start, self.now_us);
-                }
+                self.after_boot(self.now_us);
             }
             if self.events.is_full() {
                 self.events.pop_front();
@@ -472,15 +597,15 @@ impl<S: ParamStore> Canopenia<S> {
     }
 }
 
-impl<S: ParamStore> Device for Canopenia<S> {
+impl<S: ParamStore, M: Storage> Device for Canopenia<S, M> {
     fn start(&mut self, now_us: u64) {
         self.now_us = now_us;
         self.node.start(now_us);
+        self.serial_to_program();
+        self.apply_configuration(Area::ALL);
         self.hardware = HW_INIT;
         self.shown = [0xFF; 3];
-        if self.autorun {
-            self.own_nmt(NmtCommand::Start, now_us);
-        }
+        self.after_boot(now_us);
         self.after_input(now_us);
     }
 
@@ -488,13 +613,23 @@ impl<S: ParamStore> Device for Canopenia<S> {
     /// manager takes other nodes' answers, boot-ups, heartbeats and emergencies).
     fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
         self.node.on_frame(frame, now_us);
-        self.manager.on_frame(frame, now_us, &mut self.sdo_buf);
+        if self.manager_runs() {
+            self.manager.on_frame(frame, now_us, &mut self.sdo_buf);
+        }
         self.receive_all(frame);
         self.after_input(now_us);
     }
 
     fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
-        let frame = self.node.poll(now_us).or_else(|| self.manager.poll(now_us, &mut self.sdo_buf));
+        let runs = self.manager_runs();
+        let mut frame = self.node.poll(now_us).or_else(|| if runs { self.manager.poll(now_us, &mut self.sdo_buf) } else { None });
+        if frame.is_none()
+            && let Some(request) = self.program_change.take()
+        {
+            self.change_program(request, now_us);
+            // Its first frame (a boot-up, an emergency) now.
+            frame = self.node.poll(now_us);
+        }
         self.after_input(now_us);
         frame
     }
@@ -530,7 +665,7 @@ impl<S: ParamStore> Device for Canopenia<S> {
     }
 }
 
-impl<S: ParamStore> HostPort for Canopenia<S> {
+impl<S: ParamStore, M: Storage> HostPort for Canopenia<S, M> {
     fn on_host_byte(&mut self, byte: u8, now_ms: u64) {
         // The framing compares wrapping differences of a 32-bit millisecond clock.
         let command = match self.host.push(byte, now_ms as Millis) {
@@ -554,17 +689,34 @@ impl<S: ParamStore> HostPort for Canopenia<S> {
     }
 }
 
-/// The coprocessor at `node_id` with its parameters in a block store from the runtime.
-impl<M: embedded_storage::Storage> Assemble<M> for Canopenia<BlockStore<M>> {
+/// The settings of the active file in `app`'s configuration memory.
+fn settings_of<M: Storage>(app: &mut Coprocessor<M>) -> Settings {
+    let mut buf = [0_u8; FILE_MAX];
+    app.program.active(&mut buf).map_or(Settings::FIRMWARE, |file| Settings::of(file.header()))
+}
+
+impl<S: ParamStore, M: Storage> Canopenia<S, M> {
+    /// The activation key is the serial number 1018h.4 holds.
+    fn serial_to_program(&mut self) {
+        let mut serial = [0_u8; 4];
+        let _ = self.node.read(index::IDENTITY_OBJECT, 4, 0, &mut serial, Side::Device);
+        self.node.od_mut().app.program.serial = u32::from_le_bytes(serial);
+    }
+}
+
+/// The coprocessor at `node_id` with its parameters and its configuration files in memories
+/// from the runtime ("parameters", "configuration").
+impl<M: Storage> Assemble<M> for Canopenia<BlockStore<M>, M> {
     fn mode_names(f: &mut dyn FnMut(&'static str)) {
-        mode_names::<Od<Typed<Coprocessor>>>(f);
+        mode_names::<Od<Typed<Coprocessor<M>>>>(f);
     }
 
     fn assemble(mode: Option<&str>, node_id: u8, memory: &mut dyn FnMut(MemoryRequest) -> Option<M>) -> Result<Self, AssembleError> {
-        assembly_mode::<Od<Typed<Coprocessor>>>(mode, node_id)?;
-        let size = <Od<Typed<Coprocessor>> as NodeDictionary>::PERSISTENT_SIZE;
-        let request = MemoryRequest { name: "parameters", capacity: BlockStore::<M>::capacity_for(size) };
-        let storage = memory(request).ok_or(AssembleError::NoMemory(request.name))?;
-        Ok(Canopenia::new(node_id, BlockStore::new(storage, 0)))
+        assembly_mode::<Od<Typed<Coprocessor<M>>>>(mode, node_id)?;
+        let size = <Od<Typed<Coprocessor<M>>> as NodeDictionary>::PERSISTENT_SIZE;
+        let mut take = |name, capacity| memory(MemoryRequest { name, capacity }).ok_or(AssembleError::NoMemory(name));
+        let params = take("parameters", BlockStore::<M>::capacity_for(size))?;
+        let config = take("configuration", crate::config::slots::ConfigSlots::<M>::CAPACITY)?;
+        Ok(Canopenia::with_configuration(node_id, BlockStore::new(params, 0), config))
     }
 }

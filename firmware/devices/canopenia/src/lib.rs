@@ -6,6 +6,7 @@
 //! - [`objects`]: the coprocessor's own dictionary hooks: program data, writes to act on;
 //! - [`status`]: NODESTATUS, the codes of 5F04h;
 //! - [`cache`]: remote reads answered from the manager's scans;
+//! - [`config`]: configuration loading: 1F50h/1F51h, the two slots, checking and applying a binary EDS;
 //! - [`device`]: the whole coprocessor, driven by CAN frames, serial bytes and time.
 #![no_std]
 #![forbid(unsafe_code)]
@@ -16,6 +17,7 @@
 coforge_macros::device!("../../../spec/canopenia.yaml");
 
 pub mod cache;
+pub mod config;
 pub mod device;
 pub mod errors;
 pub mod host;

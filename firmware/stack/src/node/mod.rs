@@ -301,6 +301,16 @@ impl<D: NodeDictionary, S: ParamStore, const N: usize, const P: usize> Node<D, S
         }
     }
 
+    /// Loads the stored parameters of `area` again over what the dictionary holds now, and
+    /// reloads the services from it: for a device that writes its own defaults (a loaded
+    /// configuration) after an initialisation, so that what 1010h saved still wins.
+    pub fn reload_stored(&mut self, area: Area) {
+        // As at an initialisation: a store that cannot be read leaves what the entries hold.
+        let _ = self.core.store.load(&mut self.core.od, area);
+        let now_us = self.core.now_us;
+        self.core.reload_all(now_us);
+    }
+
     pub fn od(&self) -> &D {
         &self.core.od
     }

@@ -125,7 +125,7 @@ fn main() -> ! {
         host_bytes(chip, &cmd[..n]);
         chip.host_output(NOW_MS, &mut out)
     });
-    let m = answer(&DeviceToHost::ReadLocalResponse { index: 0x1000, sub: 0, err: 0, data: &0x0003_0191_u32.to_le_bytes() }, &mut want);
+    let m = answer(&DeviceToHost::ReadLocalResponse { index: 0x1000, sub: 0, err: 0, data: &0x000F_0191_u32.to_le_bytes() }, &mut want);
     expect_bytes("R 1000h", &out[..got], &want[..m]);
 
     let n = command(&HostToDevice::ReadRemoteRequest { node_id: REMOTE, index: 0x1018, sub: 1 }, &mut cmd);

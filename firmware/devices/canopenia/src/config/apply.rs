@@ -1,0 +1,88 @@
+//! A checked binary EDS as writes into the dictionary: the values of its entries, then its
+//! PDO configuration, for the entries of one reset area. The device writes them with its own
+//! rights after every initialisation, before what 1010h saved is loaded over them.
+
+use super::check::{SERVED_BY_FIRMWARE, mapped};
+use coforge_beds::{BinaryEds, PdoRecord, Table};
+use coforge_stack::od::{Area, EntryInfo, find};
+
+/// Entries a file lists that are not configuration: what the firmware serves itself
+/// (erratum COIA-39), and the loading interface 1F50h/1F51h (a key and a stop command written
+/// as "defaults" would send the device back into bootloader mode).
+const NOT_CONFIGURATION: [u16; 3] = [SERVED_BY_FIRMWARE, 0x1F50, 0x1F51];
+const RPDO_COMM: u16 = 0x1400;
+const TPDO_COMM: u16 = 0x1800;
+const MAPPING: u16 = 0x200;
+/// COB-ID bit 31: the PDO does not exist (is not valid).
+const PDO_INVALID: u32 = 1 << 31;
+
+/// Calls `write` with every value of `file` for the entries of `area`, in an order the
+/// dictionary's PDO rules accept.
+pub fn apply(file: &BinaryEds<'_>, entries: &[EntryInfo], area: Area, node_id: u8, write: &mut dyn FnMut(u16, u8, &[u8])) {
+    let wanted = |index: u16, sub: u8| area.contains(index) && !NOT_CONFIGURATION.contains(&index) && !is_structure(entries, index, sub);
+    for r in file.sdo_replies().filter(|r| wanted(r.index, r.sub)) {
+        write(r.index, r.sub, r.value());
+    }
+    for e in file.od_entries().filter(|e| wanted(e.index, e.sub)) {
+        write(e.index, e.sub, file.image_value(Table::Defaults, e.offset, e.size()));
+    }
+    for e in file.generic_entries().filter(|e| wanted(e.index, e.sub)) {
+        write(e.index, e.sub, file.image_value(Table::Defaults, e.offset, e.size));
+    }
+    if area.contains(RPDO_COMM) {
+        pdos(file, entries, Table::Rpdos, RPDO_COMM, node_id, write);
+        pdos(file, entries, Table::Tpdos, TPDO_COMM, node_id, write);
+    }
+}
+
+/// Sub-index 0 of an array or record: the dictionary's structure, not a value to take.
+fn is_structure(entries: &[EntryInfo], index: u16, sub: u8) -> bool {
+    sub == 0 && find(entries, index, 1).is_ok()
+}
+
+/// The file's PDOs of one direction; the dictionary's PDOs the file does not configure are
+/// made invalid.
+fn pdos(file: &BinaryEds<'_>, entries: &[EntryInfo], table: Table, base: u16, node_id: u8, write: &mut dyn FnMut(u16, u8, &[u8])) {
+    let mut configured = 0_u64;
+    for pdo in file.pdos(table) {
+        let Some(n) = pdo.number.checked_sub(1) else { continue };
+        configured |= 1_u64.checked_shl(u32::from(n)).unwrap_or(0);
+        pdo_writes(file, &pdo, base + u16::from(n), table == Table::Rpdos, write);
+    }
+    for n in 0..64_u16 {
+        let comm = base + n;
+        if find(entries, comm, 1).is_err() {
+            break;
+        }
+        if configured & (1 << n) == 0 {
+            write(comm, 1, &default_cob(base, n, node_id).to_le_bytes());
+        }
+    }
+}
+
+/// The COB-ID a PDO the file leaves out gets: CiA 301's default identifier, marked invalid.
+fn default_cob(base: u16, n: u16, node_id: u8) -> u32 {
+    let function = if base == RPDO_COMM { 0x200 } else { 0x180 };
+    PDO_INVALID | (function + 0x100 * u32::from(n % 4) + u32::from(node_id))
+}
+
+/// One PDO: invalid while it is remapped (CiA 301's order), then its parameters.
+fn pdo_writes(file: &BinaryEds<'_>, pdo: &PdoRecord, comm: u16, receive: bool, write: &mut dyn FnMut(u16, u8, &[u8])) {
+    let map = comm + MAPPING;
+    write(comm, 1, &(pdo.cob_id | PDO_INVALID).to_le_bytes());
+    write(map, 0, &[0]);
+    let mut count = 0_u8;
+    for e in mapped(file, pdo) {
+        count += 1;
+        let entry = (u32::from(e.index) << 16) | (u32::from(e.sub) << 8) | (u32::from(e.size()) * 8);
+        write(map, count, &entry.to_le_bytes());
+    }
+    write(map, 0, &[count]);
+    write(comm, 2, &[pdo.transmission_type]);
+    if !receive {
+        // The file holds the inhibit time in ms, 1800h.3 counts 100 us (erratum COIA-38).
+        write(comm, 3, &pdo.inhibit_time.saturating_mul(10).to_le_bytes());
+        write(comm, 5, &pdo.event_time.to_le_bytes());
+    }
+    write(comm, 1, &pdo.cob_id.to_le_bytes());
+}
