@@ -160,10 +160,13 @@ def err_of(payload, at):
 class Target:
     """A running coprocessor, `kind` "sim" or "qemu", with python-canopen and the host."""
 
-    def __init__(self, kind, workdir):
+    def __init__(self, kind, workdir, store=False):
+        """`store`: the simulator keeps its memories in files in `workdir` (QEMU always does),
+        so that they survive a restart."""
         self.net = self.host = None
         if kind == "sim":
-            self.sim = SimProcess([COFORGE, "sim", "canopenia", "--node-id", str(NODE_ID), "--port", "0", "--serial", "0"])
+            keep = ["--store", str(pathlib.Path(workdir) / "canopenia")] if store else []
+            self.sim = SimProcess([COFORGE, "sim", "canopenia", "--node-id", str(NODE_ID), "--port", "0", "--serial", "0", *keep])
         else:
             self.sim = QemuProcess(IA_IMAGE, workdir)
         try:

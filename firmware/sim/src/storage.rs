@@ -68,3 +68,10 @@ impl Storage for Eeprom {
         Ok(())
     }
 }
+
+/// CANopenIA's configuration files are read where they are stored.
+impl canopenia::config::slots::MappedStorage for Eeprom {
+    fn mapped(&self) -> &[u8] {
+        self.ram.as_bytes()
+    }
+}

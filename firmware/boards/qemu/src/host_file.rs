@@ -88,3 +88,10 @@ impl Storage for HostFileEeprom<'_> {
         self.write_file(offset, bytes.len())
     }
 }
+
+/// CANopenIA's configuration files are read where they are stored: in the RAM image.
+impl canopenia::config::slots::MappedStorage for HostFileEeprom<'_> {
+    fn mapped(&self) -> &[u8] {
+        self.ram.as_bytes()
+    }
+}

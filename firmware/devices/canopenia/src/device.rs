@@ -35,8 +35,8 @@
 //!   its values are written after every initialisation, before what 1010h saved.
 
 use crate::app::Typed;
-use crate::config::program::ProgramRequest;
-use crate::config::slots::{FILE_MAX, NoMemory};
+use crate::config::program::{ProgramRequest, checked_active};
+use crate::config::slots::{MappedStorage, NoMemory};
 use crate::config::{Settings, apply};
 use crate::errors;
 use crate::host::{self, Command, MAX_VALUE, Request};
@@ -56,7 +56,6 @@ use coforge_stack::node::{BusState, NodeEvent};
 use coforge_stack::od::{Area, NodeDictionary, Side};
 use coforge_stack::sdo::client::{SdoResult, StartError};
 use coforge_stack::store::{BlockStore, ParamStore};
-use embedded_storage::Storage;
 use heapless::Deque;
 
 /// Scans the manager keeps (node records, each with this many PDOs each way).
@@ -140,13 +139,13 @@ impl<S: ParamStore> Canopenia<S, NoMemory> {
     }
 }
 
-impl<S: ParamStore, M: Storage> Canopenia<S, M> {
+impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
     /// A coprocessor whose configuration files live in `memory` (at least
     /// [`ConfigSlots::CAPACITY`](crate::config::slots::ConfigSlots::CAPACITY) bytes); the
     /// active file's node-ID, if it sets one, replaces `node_id`.
     pub fn with_configuration(node_id: u8, store: S, memory: M) -> Self {
-        let mut app = Coprocessor::new(memory);
-        let settings = settings_of(&mut app);
+        let app = Coprocessor::new(memory);
+        let settings = settings_of(&app);
         let own_id = settings.node_id.unwrap_or(node_id);
         let od = Od::new(Mode::Default, own_id, Typed(app));
         Canopenia {
@@ -204,22 +203,26 @@ impl<S: ParamStore, M: Storage> Canopenia<S, M> {
         }
     }
 
-    /// The active file's values for `area`, then what 1010h saved over them.
+    /// The active file's values for `area`, then what 1010h saved over them. The files are
+    /// lent out of the dictionary's app part while their values are written into it.
     fn apply_configuration(&mut self, area: Area) {
         if self.in_bootloader() {
             return;
         }
-        let mut buf = [0_u8; FILE_MAX];
-        let Some(file) = self.node.od_mut().app.program.active(&mut buf) else { return };
+        let Some(slots) = self.node.od_mut().app.program.lend() else { return };
+        let entries = crate::od::entries(Mode::Default);
         let node_id = self.node.node_id();
         let mut failed = 0_u32;
-        let node = &mut self.node;
-        apply::apply(&file, crate::od::entries(Mode::Default), area, node_id, &mut |index, sub, data| {
-            if node.write(index, sub, data, Side::Device).is_err() {
-                failed += 1;
-            }
-        });
-        self.node.reload_stored(area);
+        if let Some(file) = checked_active(&slots, entries) {
+            let node = &mut self.node;
+            apply::apply(&file, entries, area, node_id, &mut |index, sub, data| {
+                if node.write(index, sub, data, Side::Device).is_err() {
+                    failed += 1;
+                }
+            });
+            self.node.reload_stored(area);
+        }
+        self.node.od_mut().app.program.give_back(slots);
         self.config_write_errors = self.config_write_errors.saturating_add(failed);
     }
 
@@ -238,7 +241,7 @@ impl<S: ParamStore, M: Storage> Canopenia<S, M> {
                     self.node.send_frame(frame);
                 }
                 self.node.od_mut().app.program.entered(false);
-                self.settings = settings_of(&mut self.node.od_mut().app);
+                self.settings = settings_of(&self.node.od().app);
                 self.node.set_node_id(self.settings.node_id.unwrap_or(self.hardware_node_id));
                 self.program_change = Some(ProgramRequest::Restart);
                 return;
@@ -597,7 +600,7 @@ impl<S: ParamStore, M: Storage> Canopenia<S, M> {
     }
 }
 
-impl<S: ParamStore, M: Storage> Device for Canopenia<S, M> {
+impl<S: ParamStore, M: MappedStorage> Device for Canopenia<S, M> {
     fn start(&mut self, now_us: u64) {
         self.now_us = now_us;
         self.node.start(now_us);
@@ -665,7 +668,7 @@ impl<S: ParamStore, M: Storage> Device for Canopenia<S, M> {
     }
 }
 
-impl<S: ParamStore, M: Storage> HostPort for Canopenia<S, M> {
+impl<S: ParamStore, M: MappedStorage> HostPort for Canopenia<S, M> {
     fn on_host_byte(&mut self, byte: u8, now_ms: u64) {
         // The framing compares wrapping differences of a 32-bit millisecond clock.
         let command = match self.host.push(byte, now_ms as Millis) {
@@ -690,12 +693,11 @@ impl<S: ParamStore, M: Storage> HostPort for Canopenia<S, M> {
 }
 
 /// The settings of the active file in `app`'s configuration memory.
-fn settings_of<M: Storage>(app: &mut Coprocessor<M>) -> Settings {
-    let mut buf = [0_u8; FILE_MAX];
-    app.program.active(&mut buf).map_or(Settings::FIRMWARE, |file| Settings::of(file.header()))
+fn settings_of<M: MappedStorage>(app: &Coprocessor<M>) -> Settings {
+    app.program.active().map_or(Settings::FIRMWARE, |file| Settings::of(file.header()))
 }
 
-impl<S: ParamStore, M: Storage> Canopenia<S, M> {
+impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
     /// The activation key is the serial number 1018h.4 holds.
     fn serial_to_program(&mut self) {
         let mut serial = [0_u8; 4];
@@ -706,7 +708,7 @@ impl<S: ParamStore, M: Storage> Canopenia<S, M> {
 
 /// The coprocessor at `node_id` with its parameters and its configuration files in memories
 /// from the runtime ("parameters", "configuration").
-impl<M: Storage> Assemble<M> for Canopenia<BlockStore<M>, M> {
+impl<M: MappedStorage> Assemble<M> for Canopenia<BlockStore<M>, M> {
     fn mode_names(f: &mut dyn FnMut(&'static str)) {
         mode_names::<Od<Typed<Coprocessor<M>>>>(f);
     }

@@ -7,10 +7,9 @@
 
 use crate::app::Hooks;
 use crate::config::program::Program;
-use crate::config::slots::NoMemory;
+use crate::config::slots::{MappedStorage, NoMemory};
 use crate::index;
 use coforge_stack::od::{ReadLen, SdoAbort, WriteSource};
-use embedded_storage::Storage;
 use heapless::Deque;
 
 /// Bytes of a written value kept: the most a PDO carries, and more than the node's largest
@@ -53,7 +52,7 @@ pub struct Coprocessor<M = NoMemory> {
     pub program: Program<M>,
 }
 
-impl<M: Storage> Coprocessor<M> {
+impl<M: MappedStorage> Coprocessor<M> {
     pub fn new(memory: M) -> Self {
         let entries = crate::od::entries(crate::Mode::Default);
         Coprocessor { writes: Deque::new(), writes_dropped: 0, program: Program::new(memory, entries) }
@@ -65,7 +64,7 @@ impl<M: Storage> Coprocessor<M> {
     }
 }
 
-impl<M: Storage> Hooks for Coprocessor<M> {
+impl<M: MappedStorage> Hooks for Coprocessor<M> {
     /// Program data is write-only: the dictionary refuses reads before this hook.
     fn read_program_data(&mut self, _sub: u8, _offset: usize, _buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
         Err(SdoAbort::WriteOnly)

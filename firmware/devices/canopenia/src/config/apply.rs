@@ -10,6 +10,9 @@ use coforge_stack::od::{Area, EntryInfo, find};
 /// (erratum COIA-39), and the loading interface 1F50h/1F51h (a key and a stop command written
 /// as "defaults" would send the device back into bootloader mode).
 const NOT_CONFIGURATION: [u16; 3] = [SERVED_BY_FIRMWARE, 0x1F50, 0x1F51];
+/// Entries that belong to the chip, not to a configuration: its serial number (1018h.4, the
+/// activation key) and its chip ID (5F00h.5).
+const CHIP_OWN: [(u16, u8); 2] = [(0x1018, 4), (0x5F00, 5)];
 const RPDO_COMM: u16 = 0x1400;
 const TPDO_COMM: u16 = 0x1800;
 const MAPPING: u16 = 0x200;
@@ -19,7 +22,9 @@ const PDO_INVALID: u32 = 1 << 31;
 /// Calls `write` with every value of `file` for the entries of `area`, in an order the
 /// dictionary's PDO rules accept.
 pub fn apply(file: &BinaryEds<'_>, entries: &[EntryInfo], area: Area, node_id: u8, write: &mut dyn FnMut(u16, u8, &[u8])) {
-    let wanted = |index: u16, sub: u8| area.contains(index) && !NOT_CONFIGURATION.contains(&index) && !is_structure(entries, index, sub);
+    let wanted = |index: u16, sub: u8| {
+        area.contains(index) && !NOT_CONFIGURATION.contains(&index) && !CHIP_OWN.contains(&(index, sub)) && !is_structure(entries, index, sub)
+    };
     for r in file.sdo_replies().filter(|r| wanted(r.index, r.sub)) {
         write(r.index, r.sub, r.value());
     }

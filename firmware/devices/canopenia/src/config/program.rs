@@ -15,10 +15,9 @@
 //! bootloader mode 1F50h.2 answers 0800 0022h.
 
 use super::check::check;
-use super::slots::{ConfigSlots, FILE_MAX, SlotError};
+use super::slots::{ConfigSlots, MappedStorage, SlotError};
 use coforge_beds::BinaryEds;
 use coforge_stack::od::{EntryInfo, SdoAbort};
-use embedded_storage::Storage;
 
 /// What the device has to do after the input that asked for it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,7 +39,8 @@ const CLEAR: u8 = 3;
 /// The program state behind 1F50h/1F51h, on configuration memory `M`.
 #[derive(Debug)]
 pub struct Program<M> {
-    slots: ConfigSlots<M>,
+    /// The files; lent to the device while it writes a file's values into the dictionary.
+    slots: Option<ConfigSlots<M>>,
     bootloader: bool,
     /// 1F50h.1 held the serial number when it was last written.
     key: bool,
@@ -60,9 +60,16 @@ fn storage_abort(e: SlotError) -> SdoAbort {
     }
 }
 
-impl<M: Storage> Program<M> {
+/// The active file of `slots`, checked again against `entries` (storage may have decayed since
+/// it was stored): `None` if there is none or it no longer passes.
+pub fn checked_active<'s, M: MappedStorage>(slots: &'s ConfigSlots<M>, entries: &[EntryInfo]) -> Option<BinaryEds<'s>> {
+    let file = BinaryEds::parse(slots.active()?).ok()?;
+    check(&file, entries).ok().map(|()| file)
+}
+
+impl<M: MappedStorage> Program<M> {
     pub fn new(memory: M, entries: &'static [EntryInfo]) -> Self {
-        Program { slots: ConfigSlots::new(memory), bootloader: false, key: false, serial: 0, received: 0, request: None, entries }
+        Program { slots: Some(ConfigSlots::new(memory)), bootloader: false, key: false, serial: 0, received: 0, request: None, entries }
     }
 
     pub fn in_bootloader(&self) -> bool {
@@ -79,19 +86,29 @@ impl<M: Storage> Program<M> {
         self.bootloader = bootloader;
         self.key = false;
         self.received = 0;
-        self.slots.discard();
+        if let Some(slots) = self.slots.as_mut() {
+            slots.discard();
+        }
     }
 
-    /// The active file in `buf`, checked again (storage may have decayed since it was
-    /// stored): `None` if there is none or it no longer passes.
-    pub fn active<'b>(&mut self, buf: &'b mut [u8]) -> Option<BinaryEds<'b>> {
-        let entries = self.entries;
-        let file = BinaryEds::parse(self.slots.active(buf)?).ok()?;
-        check(&file, entries).ok().map(|()| file)
+    /// The active file, checked again.
+    pub fn active(&self) -> Option<BinaryEds<'_>> {
+        checked_active(self.slots.as_ref()?, self.entries)
     }
 
-    pub fn slots(&self) -> &ConfigSlots<M> {
-        &self.slots
+    /// The files, lent to the device while it writes the active file's values into the
+    /// dictionary (whose app part this is); [`Program::give_back`] returns them.
+    pub fn lend(&mut self) -> Option<ConfigSlots<M>> {
+        self.slots.take()
+    }
+
+    pub fn give_back(&mut self, slots: ConfigSlots<M>) {
+        self.slots = Some(slots);
+    }
+
+    /// The files, unless they are lent.
+    fn slots(&mut self) -> Result<&mut ConfigSlots<M>, SdoAbort> {
+        self.slots.as_mut().ok_or(SdoAbort::DataTransferState)
     }
 
     /// 1F50h.1: the activation key.
@@ -115,7 +132,7 @@ impl<M: Storage> Program<M> {
             (START, true) => ProgramRequest::StartApplication,
             (STOP, true) | (START, false) => return Ok(()),
             (RESET, _) => ProgramRequest::Restart,
-            (CLEAR, true) => return self.slots.clear().map_err(storage_abort),
+            (CLEAR, true) => return self.slots()?.clear().map_err(storage_abort),
             _ => return Err(SdoAbort::DataTransferState),
         };
         self.request = Some(request);
@@ -127,10 +144,11 @@ impl<M: Storage> Program<M> {
         if !self.bootloader {
             return Err(SdoAbort::DataTransferState);
         }
+        let slots = self.slots()?;
         if offset == 0 {
-            self.slots.begin().map_err(storage_abort)?;
+            slots.begin().map_err(storage_abort)?;
         }
-        self.slots.write(offset, data).map_err(storage_abort)?;
+        slots.write(offset, data).map_err(storage_abort)?;
         self.received = offset + data.len();
         if last { self.finish() } else { Ok(()) }
     }
@@ -140,19 +158,20 @@ impl<M: Storage> Program<M> {
         self.write_part(0, data, true)
     }
 
-    /// The whole file is in its slot: read back, checked, and made active if it passes.
+    /// The whole file is in its slot: checked where it is stored, and made active if it
+    /// passes.
     fn finish(&mut self) -> Result<(), SdoAbort> {
-        let mut buf = [0_u8; FILE_MAX];
-        let len = self.received;
-        let checked = match self.slots.downloaded(len, &mut buf).map(BinaryEds::parse) {
+        let (len, entries) = (self.received, self.entries);
+        let slots = self.slots()?;
+        let checked = match slots.downloaded(len).map(BinaryEds::parse) {
             None => Err(SdoAbort::Hardware),
             Some(Err(_)) => Err(SdoAbort::NoDictionary),
-            Some(Ok(file)) => check(&file, self.entries).map(|()| crc_of(file.bytes())),
+            Some(Ok(file)) => check(&file, entries).map(|()| crc_of(file.bytes())),
         };
         match checked {
-            Ok(crc) => self.slots.commit(len, crc).map_err(storage_abort),
+            Ok(crc) => slots.commit(len, crc).map_err(storage_abort),
             Err(abort) => {
-                self.slots.discard();
+                slots.discard();
                 Err(abort)
             }
         }
@@ -160,7 +179,9 @@ impl<M: Storage> Program<M> {
 
     /// The download ended early (abort, timeout, reset): its slot stays without a header.
     pub fn abort_download(&mut self) {
-        self.slots.discard();
+        if let Some(slots) = self.slots.as_mut() {
+            slots.discard();
+        }
         self.received = 0;
     }
 }

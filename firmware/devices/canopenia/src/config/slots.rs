@@ -6,6 +6,10 @@
 //! header of the slot not in use, then streams the file behind it, and writes the header only
 //! once the whole file was checked: a download cut by a reset or a power loss leaves a slot
 //! without a header, and the previous file stays the active one.
+//!
+//! The memory is read in place ([`MappedStorage`]: an MCU's flash, the RAM image of an EEPROM
+//! or a host file): a file is checked and applied where it is stored, never copied, so loading
+//! one costs no RAM.
 
 use embedded_storage::Storage;
 
@@ -23,6 +27,12 @@ pub enum SlotError {
     Device,
     /// The file is longer than a slot.
     TooLong,
+}
+
+/// Storage whose bytes can be read in place.
+pub trait MappedStorage: Storage {
+    /// Every byte of the storage.
+    fn mapped(&self) -> &[u8];
 }
 
 /// A slot's header.
@@ -62,7 +72,7 @@ pub struct ConfigSlots<M> {
     writing: Option<usize>,
 }
 
-impl<M: Storage> ConfigSlots<M> {
+impl<M: MappedStorage> ConfigSlots<M> {
     /// Bytes of storage two slots take.
     pub const CAPACITY: usize = 2 * SLOT;
 
@@ -74,14 +84,13 @@ impl<M: Storage> ConfigSlots<M> {
         &self.storage
     }
 
-    fn header(&mut self, slot: usize) -> Option<Header> {
-        let mut b = [0_u8; HEADER];
-        self.storage.read((slot * SLOT) as u32, &mut b).ok()?;
-        Header::decode(&b)
+    fn header(&self, slot: usize) -> Option<Header> {
+        let at = slot * SLOT;
+        Header::decode(self.storage.mapped().get(at..at + HEADER)?.try_into().ok()?)
     }
 
     /// The slot of the newest complete file, and its header.
-    fn newest(&mut self) -> Option<(usize, Header)> {
+    fn newest(&self) -> Option<(usize, Header)> {
         let a = self.header(0).map(|h| (0, h));
         let b = self.header(1).map(|h| (1, h));
         match (a, b) {
@@ -90,17 +99,15 @@ impl<M: Storage> ConfigSlots<M> {
         }
     }
 
-    /// Reads the active file into `buf`: its bytes, or `None` if no file was ever stored or
-    /// the storage cannot be read.
-    pub fn active<'b>(&mut self, buf: &'b mut [u8]) -> Option<&'b [u8]> {
+    /// The active file, or `None` if no file was ever stored.
+    pub fn active(&self) -> Option<&[u8]> {
         let (slot, header) = self.newest()?;
-        self.read_file(slot, header.len as usize, buf)
+        self.file(slot, header.len as usize)
     }
 
-    fn read_file<'b>(&mut self, slot: usize, len: usize, buf: &'b mut [u8]) -> Option<&'b [u8]> {
-        let file = buf.get_mut(..len)?;
-        self.storage.read((slot * SLOT + HEADER) as u32, file).ok()?;
-        Some(file)
+    fn file(&self, slot: usize, len: usize) -> Option<&[u8]> {
+        let at = slot * SLOT + HEADER;
+        self.storage.mapped().get(at..at + len)
     }
 
     /// Starts a download into the slot not in use: its header is cleared first.
@@ -121,10 +128,9 @@ impl<M: Storage> ConfigSlots<M> {
         self.storage.write((slot * SLOT + HEADER + offset) as u32, data).map_err(|_| SlotError::Device)
     }
 
-    /// Reads the downloaded file (`len` bytes) back into `buf`, to be checked.
-    pub fn downloaded<'b>(&mut self, len: usize, buf: &'b mut [u8]) -> Option<&'b [u8]> {
-        let slot = self.writing?;
-        self.read_file(slot, len, buf)
+    /// The downloaded file (`len` bytes) as stored, to be checked.
+    pub fn downloaded(&self, len: usize) -> Option<&[u8]> {
+        self.file(self.writing?, len)
     }
 
     /// The downloaded file of `len` bytes becomes the active one: its header is written.
@@ -141,7 +147,7 @@ impl<M: Storage> ConfigSlots<M> {
     }
 }
 
-impl<M: Storage> ConfigSlots<M> {
+impl<M: MappedStorage> ConfigSlots<M> {
     /// No file any more (1F51h.1 = 3, clear): both headers are cleared.
     pub fn clear(&mut self) -> Result<(), SlotError> {
         self.writing = None;
@@ -170,5 +176,11 @@ impl embedded_storage::ReadStorage for NoMemory {
 impl Storage for NoMemory {
     fn write(&mut self, _: u32, _: &[u8]) -> Result<(), SlotError> {
         Err(SlotError::Device)
+    }
+}
+
+impl MappedStorage for NoMemory {
+    fn mapped(&self) -> &[u8] {
+        &[]
     }
 }
