@@ -18,7 +18,7 @@ pub struct Board {
     pub ram: (u32, u32),
 }
 
-pub const BOARDS: &[Board] = &[QEMU, STM32F0];
+pub const BOARDS: &[Board] = &[QEMU, STM32F0, STM32F091];
 
 /// QEMU's lm3s6965evb (`firmware/boards/qemu`): 256 KiB of flash, 64 KiB of RAM.
 /// `co401memory1-files` is the same module with its banks in host files (semihosting);
@@ -36,7 +36,7 @@ const QEMU: Board = Board {
 /// Boards whose images do not fit their chip yet: `dist` tries to build them and reports by
 /// how much they are over, without failing. A board moves to [`BOARDS`] once it fits (the
 /// STM32F042K6 did).
-pub const PENDING: &[Board] = &[STM32F0_GW1];
+pub const PENDING: &[Board] = &[STM32F0_GW1, STM32F0_CANOPENIA];
 
 /// The STM32F042K6 board (`firmware/boards/stm32f0`): 32 KiB of flash, 6 KiB of RAM.
 const STM32F0: Board = Board {
@@ -52,6 +52,14 @@ const STM32F0: Board = Board {
 /// requires the feature `co401gw1-image` until it fits; then `co401gw1` joins [`STM32F0`]'s
 /// devices and the feature goes.
 const STM32F0_GW1: Board = Board { devices: &["co401gw1"], features: &["co401gw1-image"], ..STM32F0 };
+
+/// CANopenIA on the same crate's STM32F042K6, which the manual lists beside the coprocessor's
+/// own F091: its `[[bin]]` requires the feature `canopenia-image` until it fits.
+const STM32F0_CANOPENIA: Board = Board { devices: &["canopenia"], features: &["canopenia-image"], ..STM32F0 };
+
+/// The STM32F091RC board (`firmware/boards/stm32f091`, the board code of `stm32f0` built for
+/// this chip, the same Cortex-M0 target): 256 KiB of flash, 32 KiB of RAM.
+const STM32F091: Board = Board { name: "stm32f091", devices: &["canopenia"], flash: (0x0800_0000, 256 * 1024), ram: (0x2000_0000, 32 * 1024), ..STM32F0 };
 
 /// The ELF an image build leaves in the board crate's target directory.
 pub(crate) fn built_elf(board: &Board, device: &str) -> PathBuf {
@@ -105,7 +113,7 @@ pub fn build() -> Result<Vec<PathBuf>> {
     // in QEMU and measures its deepest use (painted stack).
     let stacks = crate::bench::selftest()?;
     size_table(&rows, &stacks)?;
-    pending_boards();
+    pending_boards(&stacks);
     Ok(images)
 }
 
@@ -134,8 +142,9 @@ fn size_table(rows: &[Row], stacks: &[(&str, u64)]) -> Result {
 }
 
 /// Tries to link each pending board's images against its real memory map and says by how
-/// much each is over.
-fn pending_boards() {
+/// much each is over. The linker's RAM figure is static RAM only; `stacks` (as for
+/// [`size_table`]) adds the device's stack peak to it.
+fn pending_boards(stacks: &[(&str, u64)]) {
     for board in PENDING {
         let dir = root().join("firmware/boards").join(board.name);
         let mut build = cargo();
@@ -148,9 +157,19 @@ fn pending_boards() {
             Ok(o) if o.status.success() => "links: it fits; move it from PENDING to BOARDS".to_string(),
             Ok(o) => {
                 let err = String::from_utf8_lossy(&o.stderr);
-                match overflow(&err) {
-                    Some((region, n)) => format!("does not link: {region} overflowed by {n} bytes"),
-                    None => format!("does not build:\n{err}"),
+                let regions = overflow(&err);
+                if regions.is_empty() {
+                    format!("does not build:\n{err}")
+                } else {
+                    let stack = stacks.iter().find(|(d, _)| board.devices.iter().all(|device| device.starts_with(d))).map(|&(_, s)| s);
+                    let over: Vec<String> = regions
+                        .iter()
+                        .map(|(region, n)| match stack {
+                            Some(stack) if region == "RAM" => format!("RAM overflowed by {n} bytes of static RAM, {} with the stack peak ({stack})", n + stack),
+                            _ => format!("{region} overflowed by {n} bytes"),
+                        })
+                        .collect();
+                    format!("does not link: {}", over.join(", "))
                 }
             }
             Err(e) => format!("cannot run cargo: {e}"),
@@ -165,16 +184,23 @@ fn pending_boards() {
     }
 }
 
-/// The largest "region 'X' overflowed by N bytes" in a linker's output.
-fn overflow(linker: &str) -> Option<(String, u64)> {
-    linker
-        .lines()
-        .filter_map(|l| {
-            let region = l.split("in region '").nth(1)?.split('\'').next()?.to_string();
-            let n = l.split("overflowed by ").nth(1)?.split(' ').next()?.parse().ok()?;
+/// Each region's largest "region 'X' overflowed by N bytes" in a linker's output, in the
+/// order the regions first appear (FLASH, then RAM).
+fn overflow(linker: &str) -> Vec<(String, u64)> {
+    let mut regions: Vec<(String, u64)> = Vec::new();
+    for line in linker.lines() {
+        let parsed = || -> Option<(String, u64)> {
+            let region = line.split("in region '").nth(1)?.split('\'').next()?.to_string();
+            let n = line.split("overflowed by ").nth(1)?.split(' ').next()?.parse().ok()?;
             Some((region, n))
-        })
-        .max_by_key(|(_, n)| *n)
+        };
+        let Some((region, n)) = parsed() else { continue };
+        match regions.iter_mut().find(|(r, _)| *r == region) {
+            Some((_, most)) => *most = (*most).max(n),
+            None => regions.push((region, n)),
+        }
+    }
+    regions
 }
 
 /// Checks an image against its chip's memory map: the vector table at the start of flash, its
@@ -252,9 +278,10 @@ mod tests {
 
     #[test]
     fn linker_overflow_is_read_from_lld_output() {
-        let err = "  = note: rust-lld: error: section '.rodata' will not fit in region 'FLASH': overflowed by 572 bytes\n          rust-lld: error: section '.gnu.sgstubs' will not fit in region 'FLASH': overflowed by 576 bytes\n";
-        assert_eq!(super::overflow(err), Some(("FLASH".to_string(), 576)));
-        assert_eq!(super::overflow("error[E0308]: mismatched types"), None);
+        let err = "  = note: rust-lld: error: section '.rodata' will not fit in region 'FLASH': overflowed by 572 bytes\n          rust-lld: error: section '.gnu.sgstubs' will not fit in region 'FLASH': overflowed by 576 bytes\n          rust-lld: error: section '.bss' will not fit in region 'RAM': overflowed by 1124 bytes\n          rust-lld: error: section '.uninit' will not fit in region 'RAM': overflowed by 1124 bytes\n";
+        assert_eq!(super::overflow(err), [("FLASH".to_string(), 576), ("RAM".to_string(), 1124)]);
+        assert_eq!(super::overflow(&err[..err.find(".bss").unwrap()]), [("FLASH".to_string(), 576)]);
+        assert!(super::overflow("error[E0308]: mismatched types").is_empty());
     }
 
     /// An ELF32 header and `segments` as PT_LOAD program headers, data after them.
@@ -278,7 +305,7 @@ mod tests {
     }
 
     /// Every image `cargo xtask dist` built (the suite builds them before), on every board:
-    /// the QEMU lm3s6965 and the STM32F042K6.
+    /// the QEMU lm3s6965, the STM32F042K6 and the STM32F091RC.
     #[test]
     fn every_built_image_fits_its_chips_memory_map() {
         for board in super::BOARDS {
@@ -305,6 +332,9 @@ mod tests {
         assert!(super::flash_args(&args("--device")).unwrap_err().contains("needs a value"));
         assert!(super::chip_of("qemu").unwrap_err().contains("QEMU"));
         assert_eq!(super::chip_of("stm32f0"), Ok("STM32F042K6Tx"));
+        assert_eq!(super::chip_of("stm32f091"), Ok("STM32F091RCTx"));
+        let nope = super::chip_of("nope").unwrap_err();
+        assert!(nope.contains("stm32f0, stm32f091"), "{nope}");
         assert!(super::chip_of("nope").unwrap_err().contains("--chip"));
     }
 
@@ -347,6 +377,7 @@ pub fn chip_of(board: &str) -> std::result::Result<&'static str, String> {
     match board {
         "qemu" => Err("the qemu board's images run in QEMU, not on a probe: see \"Running an image in QEMU\" in README.md".into()),
         "stm32f0" => Ok("STM32F042K6Tx"),
+        "stm32f091" => Ok("STM32F091RCTx"),
         other => {
             let known: Vec<&str> = BOARDS.iter().map(|b| b.name).collect();
             Err(format!("no board `{other}` to flash (boards: {}); pass --chip to flash an image of your own board", known.join(", ")))

@@ -10,6 +10,8 @@
 //! Transfers are limited to 255 bytes per direction (one NBYTES load; the banks never move
 //! more than a 132-byte block slot, eeprom24x at most a 66-byte page write).
 
+use crate::clock::MsDelay;
+use eeprom24x::{Eeprom24x, SlaveAddr, addr_size::TwoBytes, page_size::B64, unique_serial::No};
 use embedded_hal::i2c::{ErrorKind, ErrorType, NoAcknowledgeSource, Operation, SevenBitAddress};
 use stm32f0xx_hal::pac::I2C1;
 
@@ -46,6 +48,18 @@ impl embedded_hal::i2c::Error for Error {
             Error::Timeout | Error::Unsupported => ErrorKind::Other,
         }
     }
+}
+
+/// A parameter EEPROM, the only device on the bus: a 24C128 (16 KiB, 64-byte pages, two
+/// address bytes) at 0x50 (A2..A0 = 000). CO401GW1's and CANopenIA's 1010h/1011h store.
+pub type ParamEeprom = eeprom24x::Storage<I2cBus, B64, TwoBytes, No, MsDelay>;
+
+/// The 24C128's size.
+pub const PARAM_EEPROM_BYTES: usize = 16 * 1024;
+
+/// The parameter EEPROM on I2C1, taken as [`I2cBus::new`] takes it.
+pub fn param_eeprom(regs: I2C1) -> ParamEeprom {
+    eeprom24x::Storage::new(Eeprom24x::new_24x128(I2cBus::new(regs), SlaveAddr::Default), MsDelay)
 }
 
 /// I2C1 as a bus master.

@@ -57,6 +57,14 @@
 //! | 8 MHz crystal | PF0 (5) / PF1 (6) | HSE, PLL x6 = 48 MHz |
 //! | SWDIO / SWCLK | PA13 (34) / PA14 (37) | debug, flashing |
 //! | spare | PC13 (2), PC14 (3), PC15 (4) | |
+//!
+//! # CANopenIA on the STM32F091RC and the STM32F042K6
+//!
+//! `coprocessor::run` (feature `canopenia`) is the whole CANopenIA image for either chip (pins
+//! in `firmware/boards/stm32f091/PINS.md`): `firmware/boards/stm32f091` builds this library
+//! with the features `stm32f091` and `canopenia` for its image; this crate's `canopenia` is the
+//! STM32F042K6 image, which does not fit the chip yet (feature `canopenia-image`, pending in
+//! `dist`).
 #![no_std]
 // One read of a status register (`serve::esr`) and the GW1 board's port registers
 // (`gw1::Ports`) are the only `unsafe`.
@@ -66,6 +74,8 @@
 pub mod board;
 pub mod can;
 pub mod clock;
+#[cfg(feature = "canopenia")]
+pub mod coprocessor;
 pub mod gw1;
 pub mod i2c;
 pub mod serve;

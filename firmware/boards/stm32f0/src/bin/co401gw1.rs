@@ -13,13 +13,13 @@ use co401gw1::app::Typed;
 use co401gw1::{Board, Gw1, IoImage, Od, hardware};
 use coforge_board_stm32f0::board::ConfigChain;
 use coforge_board_stm32f0::gw1::{Gw1Board, Ports};
+use coforge_board_stm32f0::i2c::{self, PARAM_EEPROM_BYTES, ParamEeprom as Eeprom};
 use coforge_board_stm32f0::serve::{OwnIndicators, serve};
-use coforge_board_stm32f0::{can, clock, i2c::I2cBus};
+use coforge_board_stm32f0::{can, clock};
 use coforge_stack::od::NodeDictionary;
 use coforge_stack::store::BlockStore;
 use core::mem::MaybeUninit;
 use cortex_m_rt::entry;
-use eeprom24x::{Eeprom24x, SlaveAddr, Storage};
 use panic_halt as _;
 use stm32f0xx_hal::can::CanInstance;
 use stm32f0xx_hal::can::bxcan::{self, filter::Mask32};
@@ -28,14 +28,10 @@ use stm32f0xx_hal::pac;
 use stm32f0xx_hal::prelude::*;
 use stm32f0xx_hal::serial::Serial;
 
-/// The parameter EEPROM: a 24C128 (16 KiB, 64-byte pages, two address bytes) at 0x50.
-type Eeprom = Storage<I2cBus, eeprom24x::page_size::B64, eeprom24x::addr_size::TwoBytes, eeprom24x::unique_serial::No, clock::MsDelay>;
 type Chip = Gw1<Gw1Board, BlockStore<Eeprom>>;
 
-/// The 24C128's size.
-const EEPROM_BYTES: usize = 16 * 1024;
 // Both slots of the parameter block fit the EEPROM (1,106 bytes today).
-const _: () = assert!(BlockStore::<Eeprom>::capacity_for(<Od<Typed<IoImage>> as NodeDictionary>::PERSISTENT_SIZE) <= EEPROM_BYTES);
+const _: () = assert!(BlockStore::<Eeprom>::capacity_for(<Od<Typed<IoImage>> as NodeDictionary>::PERSISTENT_SIZE) <= PARAM_EEPROM_BYTES);
 // The node (dictionary, every protocol engine, SDO buffer, queues, the store's handle) within
 // the 2 KiB of the MCU family the original chip ran on, measured on this target: 1,928 bytes
 // today (the whole chip with its process image, host protocol and pins: 2,712).
@@ -84,8 +80,7 @@ fn main() -> ! {
 
     // The HAL enables and resets I2C1; its timing is replaced (see `i2c`).
     let (i2c1, _pins) = I2c::i2c1(p.I2C1, i2c_pins, 400.khz(), &mut rcc).release();
-    let eeprom = Storage::new(Eeprom24x::new_24x128(I2cBus::new(i2c1), SlaveAddr::Default), clock::MsDelay);
-    let chip = build(CHIP, board, BlockStore::new(eeprom, 0));
+    let chip = build(CHIP, board, BlockStore::new(i2c::param_eeprom(i2c1), 0));
 
     let host = Serial::usart2(p.USART2, host_pins, baud.bps(), &mut rcc);
     let mut bxcan = bxcan::Can::builder(CanInstance::new(p.CAN, can_pins.0, can_pins.1, &mut rcc)).set_bit_timing(can::bit_timing(can_kbit)).leave_disabled();
