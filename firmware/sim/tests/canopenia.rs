@@ -381,3 +381,62 @@ fn autorun_starts_the_coprocessor_after_every_reset() {
     assert_eq!(seen, [d(IA, 0x5F00, 1, &[IA]), state(0x05), d(IA, 0x5F00, 3, &[0x01])], "the reset shows every status again");
     assert!(net.bus.nodes[0].console("autorun maybe").is_err());
 }
+
+#[test]
+fn rpdo_transmit_all_sends_host_writes_as_the_scanned_nodes_rpdos() {
+    let mut net = Net::new(&[("canopenia", IA), ("co401memory1", MEM)]);
+    net.run_ms(1100);
+    // RPDO transmit all on (5F01h.04 bit 3), update time 20 ms, no event or inhibit time.
+    net.command(HostToDevice::WriteLocalRequest { index: 0x5F01, sub: 4, data: &(0x087F_0017_u32 | 1 << 3).to_le_bytes() });
+    net.command(HostToDevice::WriteLocalRequest { index: 0x5F01, sub: 7, data: &[20] });
+    net.received.clear();
+    let rpdo1 = 0x200 + u16::from(MEM);
+    // The frames since log position `mark` (times can repeat: commands take no time).
+    let sent = |net: &Net, mark: usize| net.bus.log[mark..].iter().filter(|(_, f)| f.id == rpdo1).map(|(t, f)| (*t, f.payload().to_vec())).collect::<Vec<_>>();
+    let sdo_requests = |net: &Net, mark: usize| net.bus.log[mark..].iter().filter(|(_, f)| f.id == 0x600 + u16::from(MEM)).count();
+
+    // The module's RPDO1 maps 6200h.1 and .2: the first write is answered at once and goes
+    // nowhere yet (6200h.2 was never written), not even after five update times.
+    let m0 = net.bus.log.len();
+    net.command(HostToDevice::WriteRemoteRequest { node_id: MEM, index: 0x6200, sub: 1, data: &[0x00] });
+    assert_eq!(net.answers(), [Out::S { node: MEM, index: 0x6200, sub: 1, err: 0 }]);
+    net.run_ms(150);
+    assert_eq!(sent(&net, m0), [], "not every mapped entry written yet");
+    // Writing the last mapped entry sends the PDO at once, with both values; no SDO at all.
+    net.command(HostToDevice::WriteRemoteRequest { node_id: MEM, index: 0x6200, sub: 2, data: &[0x00] });
+    assert_eq!(net.answers(), [Out::S { node: MEM, index: 0x6200, sub: 2, err: 0 }]);
+    assert_eq!(sent(&net, m0).iter().map(|(_, d)| d.clone()).collect::<Vec<_>>(), [vec![0x00, 0x00]]);
+    assert_eq!(sdo_requests(&net, m0), 0);
+    // Another write of the first entry: sent when the update time (20 ms) has passed.
+    let (m1, t1) = (net.bus.log.len(), net.bus.now_us());
+    net.command(HostToDevice::WriteRemoteRequest { node_id: MEM, index: 0x6200, sub: 1, data: &[0x00] });
+    assert_eq!(net.answers(), [Out::S { node: MEM, index: 0x6200, sub: 1, err: 0 }]);
+    net.run_ms(10);
+    assert_eq!(sent(&net, m1), [], "before the update time");
+    net.run_ms(20);
+    let after = sent(&net, m1);
+    assert_eq!(after.len(), 1, "{after:?}");
+    assert!(after[0].0 - t1 >= 20_000, "{after:?}");
+    // A value of the wrong size for the mapped entry; an entry no RPDO maps goes by SDO.
+    net.command(HostToDevice::WriteRemoteRequest { node_id: MEM, index: 0x6200, sub: 1, data: &[0, 0] });
+    net.command(HostToDevice::WriteRemoteRequest { node_id: MEM, index: 0x1017, sub: 0, data: &1000_u16.to_le_bytes() });
+    assert_eq!(net.answers(), [Out::S { node: MEM, index: 0x6200, sub: 1, err: 1 << 1 }, Out::S { node: MEM, index: 0x1017, sub: 0, err: 0 }]);
+    assert_eq!(sdo_requests(&net, m1), 1);
+    // An inhibit time of 50 ms keeps the transmissions of writes every 10 ms that far apart.
+    net.command(HostToDevice::WriteLocalRequest { index: 0x5F01, sub: 9, data: &500_u16.to_le_bytes() });
+    let m3 = net.bus.log.len();
+    for _ in 0..12 {
+        net.command(HostToDevice::WriteRemoteRequest { node_id: MEM, index: 0x6200, sub: 2, data: &[0x00] });
+        net.run_ms(10);
+    }
+    let inhibited = sent(&net, m3);
+    assert!((2..=3).contains(&inhibited.len()), "{inhibited:?}");
+    assert!(inhibited.windows(2).all(|w| w[1].0 - w[0].0 >= 50_000), "{inhibited:?}");
+    net.answers();
+    // With an event time the PDO goes out cyclically, written or not.
+    net.command(HostToDevice::WriteLocalRequest { index: 0x5F01, sub: 8, data: &100_u16.to_le_bytes() });
+    let m2 = net.bus.log.len();
+    net.run_ms(1000);
+    let cyclic = sent(&net, m2);
+    assert!((9..=11).contains(&cyclic.len()), "every 100 ms: {}", cyclic.len());
+}

@@ -24,7 +24,9 @@
 //! - **Manager control** (5F01h.04, applied after every input): KEEP_OP starts a node whose
 //!   scan completed or whose heartbeat reports stopped or pre-operational; HB receive all
 //!   writes 5F01h.05 into scanned nodes' 1017h, monitors every node with 5F01h.06 and resets
-//!   a node whose heartbeat is lost; PDO receive all and use scanned entries as above.
+//!   a node whose heartbeat is lost; PDO receive all and use scanned entries as above; RPDO
+//!   transmit all sends S of an entry a scanned node maps into an RPDO as that PDO
+//!   ([`crate::rpdo_transmit`]), answered at once.
 //! - **AUTORUN** (the pin, read at power-on) or a loaded file's autostart: the coprocessor
 //!   starts itself, after power-on and after every reset.
 //! - **Configuration loading** ([`crate::config`]): the activation sequence puts the
@@ -41,6 +43,7 @@ use crate::config::{Settings, apply};
 use crate::errors;
 use crate::host::{self, Command, MAX_VALUE, Request};
 use crate::objects::{Coprocessor, Written};
+use crate::rpdo_transmit::{self, RpdoTransmit};
 use crate::serial::{self, DeviceToHost};
 use crate::{Mode, Node, Od, cache, index, status};
 use coforge_link::start_crc::reencode;
@@ -71,6 +74,7 @@ const EVENTS: usize = 8;
 const KEEP_OP: u32 = 1 << 0;
 const HB_RECEIVE_ALL: u32 = 1 << 1;
 const PDO_RECEIVE_ALL: u32 = 1 << 2;
+const RPDO_TRANSMIT_ALL: u32 = 1 << 3;
 const USE_SCANNED: u32 = 1 << 4;
 /// 5F00h.03 bits this firmware can see: INIT, ERPA, TXOR, BOFF.
 const HW_INIT: u8 = 1 << 0;
@@ -99,6 +103,8 @@ pub struct Canopenia<S, M = NoMemory> {
     host: serial::Decoder,
     out: Outbox<OUT>,
     remote: Option<Remote>,
+    /// With 5F01h.04 bit 3: host writes collected into scanned nodes' RPDOs.
+    rpdos: RpdoTransmit,
     /// The manager's caller buffer: the value S writes, where U's value lands.
     sdo_buf: [u8; MAX_VALUE],
     /// The start byte of indications: the host's latest command's.
@@ -154,6 +160,7 @@ impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
             host: serial::decoder(),
             out: Outbox::default(),
             remote: None,
+            rpdos: RpdoTransmit::default(),
             sdo_buf: [0; MAX_VALUE],
             start: serial::FRAMING.start_byte,
             shown: [0; 3],
@@ -327,6 +334,11 @@ impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
             Request::ReadLocal { index, sub } => self.read_local(&request, index, sub, Side::Host, start),
             Request::WriteRemote { node, .. } | Request::ReadRemote { node, .. } if node == self.node.node_id() => self.serve_own(&request, start),
             Request::WriteRemote { node, index, sub, ref data } => {
+                match self.write_into_rpdo(node, index, sub, data) {
+                    Some(Ok(())) => return self.answer(&request, 0, &[], start),
+                    Some(Err(rpdo_transmit::Refusal::Length)) => return self.answer(&request, serial::errors::INVALID_COMMAND_LENGTH, &[], start),
+                    None => {}
+                }
                 if let Some(err) = self.remote_refusal(node) {
                     return self.answer(&request, err, &[], start);
                 }
@@ -347,6 +359,31 @@ impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
                 let started = self.manager.upload(node, index, sub);
                 self.start_remote(&request, started, Remote { read: true, node, index, sub, start });
             }
+        }
+    }
+
+    /// With RPDO transmit all: S of an entry a scanned RPDO of `node` maps goes into that PDO
+    /// (`None`: it is not one, an SDO download is the way).
+    fn write_into_rpdo(&mut self, node: u8, index: u16, sub: u8, data: &[u8]) -> Option<Result<(), rpdo_transmit::Refusal>> {
+        if self.manager_control() & RPDO_TRANSMIT_ALL == 0 || !self.manager_runs() {
+            return None;
+        }
+        let times = self.pdo_times();
+        let scan = self.manager.scanned(node)?;
+        match self.rpdos.on_host_write(scan, index, sub, data, times, self.now_us) {
+            Ok(true) => Some(Ok(())),
+            Ok(false) => None,
+            Err(refusal) => Some(Err(refusal)),
+        }
+    }
+
+    /// The manager's default PDO times, 5F01h.07..09.
+    fn pdo_times(&self) -> rpdo_transmit::Times {
+        let c = &self.node.od().device_control;
+        rpdo_transmit::Times {
+            update_ms: c.default_pdo_update_time,
+            event_ms: c.default_pdo_transmission_event_time,
+            inhibit_100us: c.default_pdo_transmission_inhibit_time,
         }
     }
 
@@ -500,6 +537,10 @@ impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
         if let ManagerEvent::Sdo(result) = *event {
             return self.remote_done(result);
         }
+        if let ManagerEvent::Scan(ScanEvent::Complete(node)) = *event {
+            // The node's RPDOs may be others now: what the host wrote for them is void.
+            self.rpdos.forget(node);
+        }
         if let Some((node, codes)) = status::of_event(event) {
             for code in codes.into_iter().flatten() {
                 self.record_status(node, code);
@@ -626,6 +667,10 @@ impl<S: ParamStore, M: MappedStorage> Device for Canopenia<S, M> {
     fn poll(&mut self, now_us: u64) -> Option<CanFrame> {
         let runs = self.manager_runs();
         let mut frame = self.node.poll(now_us).or_else(|| if runs { self.manager.poll(now_us, &mut self.sdo_buf) } else { None });
+        if frame.is_none() && runs && self.manager_control() & RPDO_TRANSMIT_ALL != 0 {
+            let times = self.pdo_times();
+            frame = self.rpdos.check(times, now_us);
+        }
         if frame.is_none()
             && let Some(request) = self.program_change.take()
         {
@@ -677,6 +722,8 @@ impl<S: ParamStore, M: MappedStorage> HostPort for Canopenia<S, M> {
             Some(Err(_)) => None,
         };
         let start = self.host.start_byte();
+        // The command is served at this time (an RPDO's update timer starts now).
+        self.now_us = self.now_us.max(now_ms.saturating_mul(1000));
         match command {
             Some(command) if self.out.free() >= MAX_FRAME + self.reserved() => {
                 self.start = start;

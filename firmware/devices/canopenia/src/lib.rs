@@ -6,6 +6,7 @@
 //! - [`objects`]: the coprocessor's own dictionary hooks: program data, writes to act on;
 //! - [`status`]: NODESTATUS, the codes of 5F04h;
 //! - [`cache`]: remote reads answered from the manager's scans;
+//! - [`rpdo_transmit`]: host writes to scanned nodes' RPDO entries sent as those PDOs;
 //! - [`config`]: configuration loading: 1F50h/1F51h, the two slots, checking and applying a binary EDS;
 //! - [`device`]: the whole coprocessor, driven by CAN frames, serial bytes and time.
 #![no_std]
@@ -22,6 +23,7 @@ pub mod device;
 pub mod errors;
 pub mod host;
 pub mod objects;
+pub mod rpdo_transmit;
 pub mod status;
 
 pub use device::Canopenia;
