@@ -235,6 +235,27 @@ def test_the_manuals_local_examples_byte_for_byte(sim):
     assert payload == b"R\x00\x10\x00\x00\x00" + (0x000F0191).to_bytes(4, "little")
 
 
+def test_the_manuals_remote_examples_byte_for_byte(sim, tmp_path):
+    """Section 4.2's steps 3..5 as the spec's S/U examples: the host configures the coprocessor
+    itself (node 2, serial number 04040D41h) with S and U to its own node-ID, which it serves
+    with the bus's rules (erratum COIA-44), and it resets into bootloader mode as node 70h."""
+    if isinstance(sim.sim, SimProcess):
+        sim.sim.console("serial-number 04040D41")
+    # The serial number is the chip's from the next initialisation on (QEMU's board gives it
+    # at power-on already).
+    mark = sim.rec.mark()
+    sim.node.nmt.send_command(0x81)
+    assert sim.rec.wait(0x700 + NODE_ID, mark, WAIT) is not None
+    host = sim.host
+    host.silent(0.3)
+    assert host.raw_xfer(bytes.fromhex("11 05 55 02 18 10 04 39 31")) == bytes.fromhex("11 0B 55 02 18 10 04 00 00 41 0D 04 04 11 08")
+    assert host.raw_xfer(bytes.fromhex("11 09 53 02 50 1F 01 41 0D 04 04 B3 C2")) == bytes.fromhex("11 07 53 02 50 1F 01 00 00 06 93")
+    mark = sim.rec.mark()
+    assert host.raw_xfer(bytes.fromhex("11 06 53 02 51 1F 01 00 3E 04")) == bytes.fromhex("11 07 53 02 51 1F 01 00 00 57 39")
+    assert sim.rec.wait(0x770, mark, WAIT, lambda f: f.data == b"\x00") is not None, "boot-up of node 70h"
+    host.indication(b"D\x70" + bytes.fromhex("00 5F 01 70"))
+
+
 def test_error_bits_start_byte_options_and_resync(sim):
     host = sim.host
     # No such object; a host write of a read-only status entry; a value of the wrong size.

@@ -29,12 +29,14 @@ struct Net {
     decoder: serial::Decoder,
     /// Every frame the host received: its start byte and what it says.
     received: Vec<(u8, Out)>,
+    /// Every byte the host received, as sent.
+    raw: Vec<u8>,
 }
 
 impl Net {
     fn new(nodes: &[(&str, u8)]) -> Self {
         let nodes = nodes.iter().map(|(name, id)| DeviceKind::find(name).unwrap().create(None, *id, &StoreAt::Memory).unwrap()).collect();
-        let mut net = Net { bus: VirtualBus::new(nodes), decoder: serial::decoder(), received: Vec::new() };
+        let mut net = Net { bus: VirtualBus::new(nodes), decoder: serial::decoder(), received: Vec::new(), raw: Vec::new() };
         net.collect();
         net
     }
@@ -69,6 +71,7 @@ impl Net {
         let now = self.ms();
         let mut buf = [0_u8; 512];
         let n = self.bus.nodes[0].host_port().unwrap().host_output(now, &mut buf);
+        self.raw.extend_from_slice(&buf[..n]);
         for &b in &buf[..n] {
             if let Some(Ok(f)) = self.decoder.push(b, now as u32) {
                 let out = match DeviceToHost::decode(&f).unwrap() {
@@ -439,4 +442,45 @@ fn rpdo_transmit_all_sends_host_writes_as_the_scanned_nodes_rpdos() {
     net.run_ms(1000);
     let cyclic = sent(&net, m2);
     assert!((9..=11).contains(&cyclic.len()), "every 100 ms: {}", cyclic.len());
+}
+
+/// Hex bytes as the manual prints them.
+fn hex(text: &str) -> Vec<u8> {
+    text.split_whitespace().map(|b| u8::from_str_radix(b, 16).unwrap()).collect()
+}
+
+#[test]
+fn the_manuals_remote_examples_byte_for_byte_with_a_second_coprocessor() {
+    // Section 4.2's node: a second CANopenIA at node-ID 2 with serial number 04040D41h, which
+    // the host configures through this coprocessor (node 1) with S and U.
+    let mut net = Net::new(&[("canopenia", IA), ("canopenia", 2)]);
+    // KEEP_OP off, so node 2 stays pre-operational (step 2 of the sequence).
+    net.command(HostToDevice::WriteLocalRequest { index: 0x5F01, sub: 4, data: &0x087F_0016_u32.to_le_bytes() });
+    net.bus.nodes[1].console("serial-number 04040D41").unwrap();
+    net.bus.send(CanFrame::data(0, &[0x81, 2]).unwrap());
+    net.run_ms(1100);
+    net.raw.clear();
+    // The spec's examples of section 4.2 (steps 3..5), each answer byte for byte.
+    let examples = [
+        ("11 05 55 02 18 10 04 39 31", "11 0B 55 02 18 10 04 00 00 41 0D 04 04 11 08"),
+        ("11 09 53 02 50 1F 01 41 0D 04 04 B3 C2", "11 07 53 02 50 1F 01 00 00 06 93"),
+        ("11 06 53 02 51 1F 01 00 3E 04", "11 07 53 02 51 1F 01 00 00 57 39"),
+    ];
+    for (command, answer) in examples {
+        net.host_bytes(&hex(command));
+        net.run_ms(20);
+        // The answer among the indications the host also gets (start 11h: 8-bit length, CRC).
+        let mut frames = Vec::new();
+        let mut rest = std::mem::take(&mut net.raw);
+        while rest.len() >= 4 {
+            let len = 1 + 1 + usize::from(rest[1]) + 2;
+            let frame: Vec<u8> = rest.drain(..len).collect();
+            if frame[2] != b'D' {
+                frames.push(frame);
+            }
+        }
+        assert_eq!(frames, [hex(answer)], "answer to {command}");
+    }
+    // Node 2 resets into bootloader mode as node 70h.
+    assert!(net.bus.log.iter().any(|(_, f)| f.id == 0x770 && f.payload() == [0]), "boot-up of node 70h");
 }

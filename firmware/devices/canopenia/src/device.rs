@@ -118,6 +118,9 @@ pub struct Canopenia<S, M = NoMemory> {
     autorun: bool,
     /// The node-ID the runtime gives (pins, board): used when no file sets one.
     hardware_node_id: u8,
+    /// The chip's serial number (1018h.4, the activation key of section 4.2), if the runtime
+    /// gives one; otherwise 1018h.4 keeps the spec's default.
+    serial_number: Option<u32>,
     /// What the active configuration file sets besides dictionary values.
     settings: Settings,
     /// A change of program 1F50h/1F51h asked for, carried out once the node's answer left
@@ -168,6 +171,7 @@ impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
             events: Deque::new(),
             autorun: false,
             hardware_node_id: node_id,
+            serial_number: None,
             settings,
             program_change: None,
             now_us: 0,
@@ -256,6 +260,12 @@ impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
             ProgramRequest::Restart => {}
         }
         self.own_nmt(NmtCommand::ResetNode, now_us);
+    }
+
+    /// The chip's unique serial number, shown in 1018h.4 from the next initialisation on (a
+    /// loaded file does not change it).
+    pub fn set_serial_number(&mut self, serial: u32) {
+        self.serial_number = Some(serial);
     }
 
     /// The AUTORUN pin; read at power-on and at every reset of the coprocessor.
@@ -586,6 +596,7 @@ impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
                 // entries hold their defaults again (5F01h's are compared with what the
                 // manager has after this input); the coprocessor starts itself again.
                 self.apply_configuration(area);
+                self.serial_to_program();
                 self.shown = [0xFF; 3];
                 self.after_boot(self.now_us);
             }
@@ -745,8 +756,11 @@ fn settings_of<M: MappedStorage>(app: &Coprocessor<M>) -> Settings {
 }
 
 impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
-    /// The activation key is the serial number 1018h.4 holds.
+    /// 1018h.4 holds the chip's serial number, and it is the activation key.
     fn serial_to_program(&mut self) {
+        if let Some(serial) = self.serial_number {
+            let _ = self.node.write(index::IDENTITY_OBJECT, 4, &serial.to_le_bytes(), Side::Device);
+        }
         let mut serial = [0_u8; 4];
         let _ = self.node.read(index::IDENTITY_OBJECT, 4, 0, &mut serial, Side::Device);
         self.node.od_mut().app.program.serial = u32::from_le_bytes(serial);

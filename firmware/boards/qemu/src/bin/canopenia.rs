@@ -32,6 +32,9 @@ type Device = Canopenia<Store, HostFileEeprom<'static>>;
 const PARAMS: usize = Store::capacity_for(<Od<Typed<Coprocessor>> as NodeDictionary>::PERSISTENT_SIZE);
 /// The configuration file: two slots of a binary EDS each.
 const CONFIG: usize = ConfigSlots::<HostFileEeprom<'static>>::CAPACITY;
+/// The chip's serial number (1018h.4, the activation key of configuration loading): the
+/// lm3s6965 has no unique ID, so the board gives the manual's example chip's (section 4.2).
+const SERIAL_NUMBER: u32 = 0x0404_0D41;
 /// The node-ID without a loaded configuration.
 const NODE_ID: u8 = 2;
 
@@ -50,5 +53,6 @@ fn main() -> ! {
 #[inline(never)]
 fn mount(store: Store, config: HostFileEeprom<'static>) -> &'static mut Device {
     let Some(device) = cortex_m::singleton!(: Device = Canopenia::with_configuration(NODE_ID, store, config)) else { panic!("started twice") };
+    device.set_serial_number(SERIAL_NUMBER);
     device
 }
