@@ -256,6 +256,61 @@ def test_the_manuals_remote_examples_byte_for_byte(sim, tmp_path):
     host.indication(b"D\x70" + bytes.fromhex("00 5F 01 70"))
 
 
+def gateway_dictionary():
+    """The dictionary of chapter 8's node 1 (a CiA 447 gateway), as far as its indications show
+    it: TPDO1 maps 6007h, 6050h, 6053h and 6055h (8 + 16 + 16 + 24 bits), TPDO2 60B0h.1 and
+    6080h."""
+    from canopen.objectdictionary import ODArray, ODRecord, ODVariable, UNSIGNED8, UNSIGNED16, UNSIGNED24, UNSIGNED32
+
+    od = canopen.ObjectDictionary()
+
+    def var(index, sub, dtype, default, name=None, access="rw"):
+        v = ODVariable(name or f"{index:04X}sub{sub}", index, sub)
+        v.data_type, v.default, v.access_type = dtype, default, access
+        return v
+
+    def record(index, members, kind=ODRecord):
+        r = kind(f"{index:04X}", index)
+        for m in members:
+            r.add_member(m)
+        od.add_object(r)
+
+    od.add_object(var(0x1000, 0, UNSIGNED32, 0x01BF_0191, "Device type", "ro"))
+    od.add_object(var(0x1017, 0, UNSIGNED16, 0, "Producer heartbeat time"))
+    record(0x1018, [var(0x1018, 0, UNSIGNED8, 4, "count", "ro")] + [var(0x1018, s, UNSIGNED32, v, access="ro") for s, v in ((1, 0x1234), (2, 1), (3, 1), (4, 1))])
+    for n, (cob, mapping) in enumerate([(0x181, [0x60070008, 0x60500010, 0x60530010, 0x60550018]), (0x281, [0x60B00120, 0x60800008])]):
+        record(0x1800 + n, [var(0x1800 + n, 0, UNSIGNED8, 2, "count", "ro"), var(0x1800 + n, 1, UNSIGNED32, cob), var(0x1800 + n, 2, UNSIGNED8, 254)])
+        record(0x1A00 + n, [var(0x1A00 + n, 0, UNSIGNED8, len(mapping), "count")] + [var(0x1A00 + n, i + 1, UNSIGNED32, m) for i, m in enumerate(mapping)])
+    for index, dtype in ((0x6007, UNSIGNED8), (0x6050, UNSIGNED16), (0x6053, UNSIGNED16), (0x6055, UNSIGNED24), (0x6080, UNSIGNED8)):
+        od.add_object(var(index, 0, dtype, 0))
+    record(0x60B0, [var(0x60B0, 0, UNSIGNED8, 1, "count", "ro"), var(0x60B0, 1, UNSIGNED32, 0)], ODArray)
+    return od
+
+
+def test_the_manuals_indications_byte_for_byte(sim):
+    """Chapter 8's output as the spec's D examples: node 1 (python-canopen's LocalNode with the
+    gateway's dictionary) boots, is scanned and its TPDOs arrive as one D per mapped entry."""
+    gateway = canopen.LocalNode(1, gateway_dictionary())
+    sim.net.add_node(gateway)
+    sim.net.send_message(0x701, [0])
+    sim.host.indication(b"D" + bytes([NODE_ID]) + bytes.fromhex("04 5F 01 A0"), timeout=5.0)  # scan complete
+    sim.host.indications = []
+    sim.net.send_message(0x181, bytes.fromhex("00 00 00 FF FF FF FF FF"))
+    sim.net.send_message(0x281, bytes.fromhex("00 00 00 00 E0"))
+    sim.net.send_message(0x181, bytes.fromhex("01 00 00 FF FF FF FF FF"))
+    examples = [
+        "11 06 44 01 07 60 00 00 83 AD", "11 07 44 01 50 60 00 00 00 72 D2", "11 07 44 01 53 60 00 FF FF AF 21",
+        "11 08 44 01 55 60 00 FF FF FF 06 90", "11 09 44 01 B0 60 01 00 00 00 00 D6 A6", "11 06 44 01 80 60 00 E0 B8 DC",
+        "11 06 44 01 07 60 00 01 A2 BD",
+    ]
+    want = [bytes.fromhex(e) for e in examples]
+    deadline = time.monotonic() + WAIT
+    while len([i for i in sim.host.indications if i[1] == 1]) < len(want) and time.monotonic() < deadline:
+        sim.host.silent(0.1)
+    got = [encode(i) for i in sim.host.indications if i[1] == 1]
+    assert got[: len(want)] == want
+
+
 def test_error_bits_start_byte_options_and_resync(sim):
     host = sim.host
     # No such object; a host write of a read-only status entry; a value of the wrong size.
