@@ -58,8 +58,9 @@ const STM32F0_GW1: Board = Board { devices: &["co401gw1"], features: &["co401gw1
 const STM32F0_CANOPENIA: Board = Board { devices: &["canopenia"], features: &["canopenia-image"], ..STM32F0 };
 
 /// The STM32F091RC board (`firmware/boards/stm32f091`, the board code of `stm32f0` built for
-/// this chip, the same Cortex-M0 target): 256 KiB of flash, 32 KiB of RAM.
-const STM32F091: Board = Board { name: "stm32f091", devices: &["canopenia"], flash: (0x0800_0000, 256 * 1024), ram: (0x2000_0000, 32 * 1024), ..STM32F0 };
+/// this chip, the same Cortex-M0 target): 256 KiB of flash, of which the image has the first
+/// 240 KiB (the last 16 KiB are CANopenIA's configuration files), and 32 KiB of RAM.
+const STM32F091: Board = Board { name: "stm32f091", devices: &["canopenia"], flash: (0x0800_0000, 240 * 1024), ram: (0x2000_0000, 32 * 1024), ..STM32F0 };
 
 /// The ELF an image build leaves in the board crate's target directory.
 pub(crate) fn built_elf(board: &Board, device: &str) -> PathBuf {

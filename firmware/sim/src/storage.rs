@@ -70,8 +70,12 @@ impl Storage for Eeprom {
 }
 
 /// CANopenIA's configuration files are read where they are stored.
-impl canopenia::config::slots::MappedStorage for Eeprom {
+impl canopenia::config::slots::ConfigMemory for Eeprom {
     fn mapped(&self) -> &[u8] {
         self.ram.as_bytes()
+    }
+
+    fn erase(&mut self, offset: u32, len: u32) -> Result<(), StorageError> {
+        self.write(offset, &vec![0xFF; len as usize])
     }
 }

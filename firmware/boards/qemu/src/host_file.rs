@@ -90,8 +90,20 @@ impl Storage for HostFileEeprom<'_> {
 }
 
 /// CANopenIA's configuration files are read where they are stored: in the RAM image.
-impl canopenia::config::slots::MappedStorage for HostFileEeprom<'_> {
+impl canopenia::config::slots::ConfigMemory for HostFileEeprom<'_> {
     fn mapped(&self) -> &[u8] {
         self.ram.as_bytes()
+    }
+
+    /// An EEPROM has no erase: 0xFF is written, in the pieces one file write takes.
+    fn erase(&mut self, offset: u32, len: u32) -> Result<(), HostFileError> {
+        const PIECE: u32 = 256;
+        let mut at = offset;
+        while at < offset + len {
+            let n = PIECE.min(offset + len - at);
+            self.write(at, &[0xFF; PIECE as usize][..n as usize])?;
+            at += n;
+        }
+        Ok(())
     }
 }

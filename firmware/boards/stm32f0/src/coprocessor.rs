@@ -5,8 +5,12 @@
 //!
 //! - The host's remote-access protocol on USART2 (PA2 TX, PA3 RX) at 921600 8N1: 48 MHz / 52
 //!   = 923,077 baud, 0.16 % fast.
-//! - CAN on bxCAN (PA12 TX, PA11 RX, AF4) at [`CAN_KBIT`], node-ID [`NODE_ID`]: no configuration
-//!   memory yet ([`Canopenia::new`]), so no loaded file sets either.
+//! - CAN on bxCAN (PA12 TX, PA11 RX, AF4) at the bit rate and node-ID of the loaded
+//!   configuration file, or [`CAN_KBIT`] and [`NODE_ID`] without one (or when it leaves them to
+//!   the hardware). The STM32F091RC keeps its files in its last 16 KiB of flash
+//!   (`crate::config_flash`); the STM32F042K6 has no room for them (`NoMemory`).
+//! - 1018h.4, the serial number and activation key of configuration loading: the chip's unique
+//!   ID folded to 32 bits ([`serial_number`]).
 //! - AUTORUN on PA8 (input with pull-down: open = no autostart), read once at reset.
 //! - The parameters 1010h saves in a 24C128 at 0x50 on I2C1 (PB6 SCL, PB7 SDA), as CO401GW1's.
 //! - The CiA 303-3 run and error LEDs on PB0 and PB1, active low.
@@ -15,6 +19,8 @@ use crate::i2c::{self, PARAM_EEPROM_BYTES, ParamEeprom};
 use crate::serve::serve;
 use crate::{can, clock};
 use canopenia::app::Typed;
+#[cfg(not(feature = "stm32f091"))]
+use canopenia::config::slots::NoMemory;
 use canopenia::objects::Coprocessor as App;
 use canopenia::{Canopenia, Od};
 use coforge_stack::od::NodeDictionary;
@@ -27,8 +33,14 @@ use stm32f0xx_hal::pac;
 use stm32f0xx_hal::prelude::*;
 use stm32f0xx_hal::serial::Serial;
 
-/// The coprocessor with its parameter store.
-pub type Coprocessor = Canopenia<BlockStore<ParamEeprom>>;
+/// Where configuration files live: the F091's own flash; none on the F042.
+#[cfg(feature = "stm32f091")]
+type Files = crate::config_flash::ConfigFlash;
+#[cfg(not(feature = "stm32f091"))]
+type Files = NoMemory;
+
+/// The coprocessor with its parameter store and its configuration files.
+pub type Coprocessor = Canopenia<BlockStore<ParamEeprom>, Files>;
 
 /// The node-ID: the manual sets it only in a loaded configuration file (none yet), so the
 /// QEMU image's and the simulator's.
@@ -64,13 +76,20 @@ pub fn run() -> ! {
 
     // The HAL enables and resets I2C1; its timing is replaced (see `i2c`).
     let (i2c1, _pins) = I2c::i2c1(p.I2C1, i2c_pins, 400.khz(), &mut rcc).release();
-    let Some(device) = mount(BlockStore::new(i2c::param_eeprom(i2c1), 0)) else { halt() };
+    #[cfg(feature = "stm32f091")]
+    let files = crate::config_flash::ConfigFlash::new(p.FLASH);
+    #[cfg(not(feature = "stm32f091"))]
+    let files = NoMemory;
+    let Some(device) = mount(BlockStore::new(i2c::param_eeprom(i2c1), 0), files) else { halt() };
+    device.set_serial_number(serial_number());
     // Read once, before the coprocessor starts; building it took far longer than the
     // pull-down needs to settle an open pin.
     device.set_autorun(autorun.is_high().unwrap_or(false));
 
     let host = Serial::usart2(p.USART2, host_pins, HOST_BAUD.bps(), &mut rcc);
-    let mut bxcan = bxcan::Can::builder(CanInstance::new(p.CAN, can_pins.0, can_pins.1, &mut rcc)).set_bit_timing(can::bit_timing(CAN_KBIT)).leave_disabled();
+    let mut bxcan = bxcan::Can::builder(CanInstance::new(p.CAN, can_pins.0, can_pins.1, &mut rcc))
+        .set_bit_timing(can::bit_timing(device.settings().bitrate_kbit.map_or(CAN_KBIT, u32::from)))
+        .leave_disabled();
     bxcan.modify_filters().enable_bank(0, Mask32::accept_all());
     // `serve` enables the controller at once (the coprocessor's CAN side is always on).
 
@@ -80,8 +99,8 @@ pub fn run() -> ! {
 /// The coprocessor in a static (`.bss`), built in a frame of its own so that its
 /// construction's temporaries leave the stack before the loop starts.
 #[inline(never)]
-fn mount(store: BlockStore<ParamEeprom>) -> Option<&'static mut Coprocessor> {
-    cortex_m::singleton!(: Coprocessor = Canopenia::new(NODE_ID, store))
+fn mount(store: BlockStore<ParamEeprom>, files: Files) -> Option<&'static mut Coprocessor> {
+    cortex_m::singleton!(: Coprocessor = Canopenia::with_configuration(NODE_ID, store, files))
 }
 
 /// Stops for good (started twice).
@@ -89,4 +108,16 @@ fn halt() -> ! {
     loop {
         cortex_m::asm::wfi();
     }
+}
+
+/// The chip's serial number for 1018h.4: its 96-bit unique ID folded to 32 bits (XOR of its
+/// three words), the same on every start.
+pub fn serial_number() -> u32 {
+    /// The unique device ID register of the STM32F0 family (reference manual RM0091, 33.1).
+    const UID: usize = 0x1FFF_F7AC;
+    // SAFETY: UID is three read-only words of system memory, present on every STM32F0 and
+    // readable at any time; read by value, never referenced.
+    #[allow(unsafe_code)]
+    let words = unsafe { [0, 4, 8].map(|o| core::ptr::read_volatile((UID + o) as *const u32)) };
+    words.iter().fold(0, |acc, w| acc ^ w)
 }

@@ -66,14 +66,17 @@
 //! STM32F042K6 image, which does not fit the chip yet (feature `canopenia-image`, pending in
 //! `dist`).
 #![no_std]
-// One read of a status register (`serve::esr`) and the GW1 board's port registers
-// (`gw1::Ports`) are the only `unsafe`.
+// One read of a status register (`serve::esr`), the GW1 board's port registers (`gw1::Ports`),
+// the F091's configuration flash (`config_flash`: programming and reading it in place) and the
+// chip's unique ID (`coprocessor::serial_number`) are the only `unsafe`.
 #![deny(unsafe_code)]
 #![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
 
 pub mod board;
 pub mod can;
 pub mod clock;
+#[cfg(all(feature = "stm32f091", feature = "canopenia"))]
+pub mod config_flash;
 #[cfg(feature = "canopenia")]
 pub mod coprocessor;
 pub mod gw1;

@@ -38,7 +38,7 @@
 
 use crate::app::Typed;
 use crate::config::program::{ProgramRequest, checked_active};
-use crate::config::slots::{MappedStorage, NoMemory};
+use crate::config::slots::{ConfigMemory, NoMemory};
 use crate::config::{Settings, apply};
 use crate::errors;
 use crate::host::{self, Command, MAX_VALUE, Request};
@@ -148,7 +148,7 @@ impl<S: ParamStore> Canopenia<S, NoMemory> {
     }
 }
 
-impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
+impl<S: ParamStore, M: ConfigMemory> Canopenia<S, M> {
     /// A coprocessor whose configuration files live in `memory` (at least
     /// [`ConfigSlots::CAPACITY`](crate::config::slots::ConfigSlots::CAPACITY) bytes); the
     /// active file's node-ID, if it sets one, replaces `node_id`.
@@ -652,7 +652,7 @@ impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
     }
 }
 
-impl<S: ParamStore, M: MappedStorage> Device for Canopenia<S, M> {
+impl<S: ParamStore, M: ConfigMemory> Device for Canopenia<S, M> {
     fn start(&mut self, now_us: u64) {
         self.now_us = now_us;
         self.node.start(now_us);
@@ -724,7 +724,7 @@ impl<S: ParamStore, M: MappedStorage> Device for Canopenia<S, M> {
     }
 }
 
-impl<S: ParamStore, M: MappedStorage> HostPort for Canopenia<S, M> {
+impl<S: ParamStore, M: ConfigMemory> HostPort for Canopenia<S, M> {
     fn on_host_byte(&mut self, byte: u8, now_ms: u64) {
         // The framing compares wrapping differences of a 32-bit millisecond clock.
         let command = match self.host.push(byte, now_ms as Millis) {
@@ -751,11 +751,11 @@ impl<S: ParamStore, M: MappedStorage> HostPort for Canopenia<S, M> {
 }
 
 /// The settings of the active file in `app`'s configuration memory.
-fn settings_of<M: MappedStorage>(app: &Coprocessor<M>) -> Settings {
+fn settings_of<M: ConfigMemory>(app: &Coprocessor<M>) -> Settings {
     app.program.active().map_or(Settings::FIRMWARE, |file| Settings::of(file.header()))
 }
 
-impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
+impl<S: ParamStore, M: ConfigMemory> Canopenia<S, M> {
     /// 1018h.4 holds the chip's serial number, and it is the activation key.
     fn serial_to_program(&mut self) {
         if let Some(serial) = self.serial_number {
@@ -769,7 +769,7 @@ impl<S: ParamStore, M: MappedStorage> Canopenia<S, M> {
 
 /// The coprocessor at `node_id` with its parameters and its configuration files in memories
 /// from the runtime ("parameters", "configuration").
-impl<M: MappedStorage> Assemble<M> for Canopenia<BlockStore<M>, M> {
+impl<M: ConfigMemory> Assemble<M> for Canopenia<BlockStore<M>, M> {
     fn mode_names(f: &mut dyn FnMut(&'static str)) {
         mode_names::<Od<Typed<Coprocessor<M>>>>(f);
     }

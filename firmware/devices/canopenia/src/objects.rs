@@ -7,7 +7,7 @@
 
 use crate::app::Hooks;
 use crate::config::program::Program;
-use crate::config::slots::{MappedStorage, NoMemory};
+use crate::config::slots::{ConfigMemory, NoMemory};
 use crate::index;
 use coforge_stack::od::{ReadLen, SdoAbort, WriteSource};
 use heapless::Deque;
@@ -52,7 +52,7 @@ pub struct Coprocessor<M = NoMemory> {
     pub program: Program<M>,
 }
 
-impl<M: MappedStorage> Coprocessor<M> {
+impl<M: ConfigMemory> Coprocessor<M> {
     pub fn new(memory: M) -> Self {
         let entries = crate::od::entries(crate::Mode::Default);
         Coprocessor { writes: Deque::new(), writes_dropped: 0, program: Program::new(memory, entries) }
@@ -64,7 +64,7 @@ impl<M: MappedStorage> Coprocessor<M> {
     }
 }
 
-impl<M: MappedStorage> Hooks for Coprocessor<M> {
+impl<M: ConfigMemory> Hooks for Coprocessor<M> {
     /// Program data is write-only: the dictionary refuses reads before this hook.
     fn read_program_data(&mut self, _sub: u8, _offset: usize, _buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
         Err(SdoAbort::WriteOnly)

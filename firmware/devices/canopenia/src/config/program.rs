@@ -15,7 +15,7 @@
 //! bootloader mode 1F50h.2 answers 0800 0022h.
 
 use super::check::check;
-use super::slots::{ConfigSlots, MappedStorage, SlotError};
+use super::slots::{ConfigMemory, ConfigSlots, SlotError};
 use coforge_beds::BinaryEds;
 use coforge_stack::od::{EntryInfo, SdoAbort};
 
@@ -46,8 +46,6 @@ pub struct Program<M> {
     key: bool,
     /// The device's serial number (1018h.4), set by the device.
     pub serial: u32,
-    /// Bytes of the running download so far.
-    received: usize,
     request: Option<ProgramRequest>,
     /// The dictionary a file is checked against.
     entries: &'static [EntryInfo],
@@ -57,19 +55,21 @@ fn storage_abort(e: SlotError) -> SdoAbort {
     match e {
         SlotError::TooLong => SdoAbort::LengthTooHigh,
         SlotError::Device => SdoAbort::Hardware,
+        // The SDO server hands parts over in order; anything else is the server's fault.
+        SlotError::OutOfOrder => SdoAbort::General,
     }
 }
 
 /// The active file of `slots`, checked again against `entries` (storage may have decayed since
 /// it was stored): `None` if there is none or it no longer passes.
-pub fn checked_active<'s, M: MappedStorage>(slots: &'s ConfigSlots<M>, entries: &[EntryInfo]) -> Option<BinaryEds<'s>> {
+pub fn checked_active<'s, M: ConfigMemory>(slots: &'s ConfigSlots<M>, entries: &[EntryInfo]) -> Option<BinaryEds<'s>> {
     let file = BinaryEds::parse(slots.active()?).ok()?;
     check(&file, entries).ok().map(|()| file)
 }
 
-impl<M: MappedStorage> Program<M> {
+impl<M: ConfigMemory> Program<M> {
     pub fn new(memory: M, entries: &'static [EntryInfo]) -> Self {
-        Program { slots: Some(ConfigSlots::new(memory)), bootloader: false, key: false, serial: 0, received: 0, request: None, entries }
+        Program { slots: Some(ConfigSlots::new(memory)), bootloader: false, key: false, serial: 0, request: None, entries }
     }
 
     pub fn in_bootloader(&self) -> bool {
@@ -85,7 +85,6 @@ impl<M: MappedStorage> Program<M> {
     pub fn entered(&mut self, bootloader: bool) {
         self.bootloader = bootloader;
         self.key = false;
-        self.received = 0;
         if let Some(slots) = self.slots.as_mut() {
             slots.discard();
         }
@@ -149,7 +148,6 @@ impl<M: MappedStorage> Program<M> {
             slots.begin().map_err(storage_abort)?;
         }
         slots.write(offset, data).map_err(storage_abort)?;
-        self.received = offset + data.len();
         if last { self.finish() } else { Ok(()) }
     }
 
@@ -161,12 +159,17 @@ impl<M: MappedStorage> Program<M> {
     /// The whole file is in its slot: checked where it is stored, and made active if it
     /// passes.
     fn finish(&mut self) -> Result<(), SdoAbort> {
-        let (len, entries) = (self.received, self.entries);
+        let entries = self.entries;
         let slots = self.slots()?;
-        let checked = match slots.downloaded(len).map(BinaryEds::parse) {
-            None => Err(SdoAbort::Hardware),
-            Some(Err(_)) => Err(SdoAbort::NoDictionary),
-            Some(Ok(file)) => check(&file, entries).map(|()| crc_of(file.bytes())),
+        let (checked, len) = match slots.downloaded() {
+            None => (Err(SdoAbort::Hardware), 0),
+            Some(bytes) => {
+                let checked = match BinaryEds::parse(bytes) {
+                    Err(_) => Err(SdoAbort::NoDictionary),
+                    Ok(file) => check(&file, entries).map(|()| crc_of(file.bytes())),
+                };
+                (checked, bytes.len())
+            }
         };
         match checked {
             Ok(crc) => slots.commit(len, crc).map_err(storage_abort),
@@ -182,7 +185,6 @@ impl<M: MappedStorage> Program<M> {
         if let Some(slots) = self.slots.as_mut() {
             slots.discard();
         }
-        self.received = 0;
     }
 }
 

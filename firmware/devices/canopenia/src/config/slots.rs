@@ -1,38 +1,46 @@
-//! Two slots for binary EDS files on any `embedded-storage` device, so that a download never
-//! overwrites the configuration in use.
+//! Two slots for binary EDS files on the coprocessor's configuration memory, so that a download
+//! never overwrites the configuration in use.
 //!
-//! Each slot is a header (magic "BEDS", sequence number u32 LE, file length u32 LE, the file's
-//! own CRC u16 LE, 2 bytes 0) and room for [`FILE_MAX`] bytes. A download first clears the
-//! header of the slot not in use, then streams the file behind it, and writes the header only
-//! once the whole file was checked: a download cut by a reset or a power loss leaves a slot
-//! without a header, and the previous file stays the active one.
+//! Each slot is [`SLOT`] bytes: a header (magic "BEDS", sequence number u32 LE, file length u32
+//! LE, the file's own CRC u16 LE, 2 bytes 0xFF) and the file. A download first erases the slot
+//! not in use, then streams the file behind its header, and writes the header only once the
+//! whole file was checked: a download cut by a reset or a power loss leaves a slot without a
+//! header, and the previous file stays the active one.
 //!
-//! The memory is read in place ([`MappedStorage`]: an MCU's flash, the RAM image of an EEPROM
-//! or a host file): a file is checked and applied where it is stored, never copied, so loading
-//! one costs no RAM.
+//! The memory may be MCU flash ([`ConfigMemory`]): every byte is written once after an erase,
+//! in aligned blocks of [`WRITE_BLOCK`] bytes, and is read in place, so a file is checked and
+//! applied where it is stored, never copied into RAM.
 
 use embedded_storage::Storage;
 
-/// The largest binary EDS a slot holds (coforge's own export of this spec is about 6 KB, the
-/// vendor's examples 2.4 KB).
-pub const FILE_MAX: usize = 8 * 1024;
-const MAGIC: [u8; 4] = *b"BEDS";
+/// A slot: 8 KiB, whole erase pages of any STM32F0 (1 or 2 KiB).
+pub const SLOT: usize = 8 * 1024;
 const HEADER: usize = 16;
-const SLOT: usize = HEADER + FILE_MAX;
+/// The largest binary EDS a slot holds (coforge's own export of this spec is 7.9 KB, the
+/// vendor's examples 2.4 KB).
+pub const FILE_MAX: usize = SLOT - HEADER;
+/// Writes go out in aligned blocks of this many bytes (a multiple of any flash's program unit).
+pub const WRITE_BLOCK: usize = 8;
+const MAGIC: [u8; 4] = *b"BEDS";
+const ERASED: u8 = 0xFF;
+
+/// The memory configuration files live in.
+pub trait ConfigMemory: Storage {
+    /// Every byte, read in place.
+    fn mapped(&self) -> &[u8];
+    /// Sets `len` bytes from `offset` to 0xFF (a flash erase; both are multiples of [`SLOT`]).
+    fn erase(&mut self, offset: u32, len: u32) -> Result<(), Self::Error>;
+}
 
 /// Why the configuration memory failed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SlotError {
     /// The storage device reported an error, or it is smaller than two slots.
     Device,
-    /// The file is longer than a slot.
+    /// The file is longer than a slot holds.
     TooLong,
-}
-
-/// Storage whose bytes can be read in place.
-pub trait MappedStorage: Storage {
-    /// Every byte of the storage.
-    fn mapped(&self) -> &[u8];
+    /// A part that does not follow the previous one (a download streams in order).
+    OutOfOrder,
 }
 
 /// A slot's header.
@@ -45,12 +53,11 @@ struct Header {
 
 impl Header {
     fn encode(self) -> [u8; HEADER] {
-        let mut b = [0_u8; HEADER];
-        b[..4].copy_from_slice(&MAGIC);
-        b[4..8].copy_from_slice(&self.sequence.to_le_bytes());
-        b[8..12].copy_from_slice(&self.len.to_le_bytes());
-        b[12..14].copy_from_slice(&self.crc.to_le_bytes());
-        b
+        let [m0, m1, m2, m3] = MAGIC;
+        let [s0, s1, s2, s3] = self.sequence.to_le_bytes();
+        let [l0, l1, l2, l3] = self.len.to_le_bytes();
+        let [c0, c1] = self.crc.to_le_bytes();
+        [m0, m1, m2, m3, s0, s1, s2, s3, l0, l1, l2, l3, c0, c1, ERASED, ERASED]
     }
 
     fn decode(b: &[u8; HEADER]) -> Option<Header> {
@@ -64,29 +71,39 @@ impl Header {
     }
 }
 
-/// The two slots, on storage `M`.
-#[derive(Debug)]
-pub struct ConfigSlots<M> {
-    storage: M,
-    /// The slot a download is writing to.
-    writing: Option<usize>,
+/// The download being written: its slot, and the bytes not yet written as a whole block.
+#[derive(Debug, Clone, Copy)]
+struct Writing {
+    slot: usize,
+    /// File bytes received so far.
+    len: usize,
+    block: [u8; WRITE_BLOCK],
+    /// The last, partial block was written: the file is complete.
+    ended: bool,
 }
 
-impl<M: MappedStorage> ConfigSlots<M> {
-    /// Bytes of storage two slots take.
+/// The two slots, on memory `M`.
+#[derive(Debug)]
+pub struct ConfigSlots<M> {
+    memory: M,
+    writing: Option<Writing>,
+}
+
+impl<M: ConfigMemory> ConfigSlots<M> {
+    /// Bytes of memory two slots take.
     pub const CAPACITY: usize = 2 * SLOT;
 
-    pub fn new(storage: M) -> Self {
-        ConfigSlots { storage, writing: None }
+    pub fn new(memory: M) -> Self {
+        ConfigSlots { memory, writing: None }
     }
 
-    pub fn storage(&self) -> &M {
-        &self.storage
+    pub fn memory(&self) -> &M {
+        &self.memory
     }
 
     fn header(&self, slot: usize) -> Option<Header> {
         let at = slot * SLOT;
-        Header::decode(self.storage.mapped().get(at..at + HEADER)?.try_into().ok()?)
+        Header::decode(self.memory.mapped().get(at..at + HEADER)?.try_into().ok()?)
     }
 
     /// The slot of the newest complete file, and its header.
@@ -107,54 +124,77 @@ impl<M: MappedStorage> ConfigSlots<M> {
 
     fn file(&self, slot: usize, len: usize) -> Option<&[u8]> {
         let at = slot * SLOT + HEADER;
-        self.storage.mapped().get(at..at + len)
+        self.memory.mapped().get(at..at + len)
     }
 
-    /// Starts a download into the slot not in use: its header is cleared first.
+    /// Starts a download into the slot not in use, which is erased first.
     pub fn begin(&mut self) -> Result<(), SlotError> {
         let slot = self.newest().map_or(0, |(slot, _)| 1 - slot);
         self.writing = None;
-        self.storage.write((slot * SLOT) as u32, &[0; HEADER]).map_err(|_| SlotError::Device)?;
-        self.writing = Some(slot);
+        self.memory.erase((slot * SLOT) as u32, SLOT as u32).map_err(|_| SlotError::Device)?;
+        self.writing = Some(Writing { slot, len: 0, block: [ERASED; WRITE_BLOCK], ended: false });
         Ok(())
     }
 
-    /// The bytes at `offset` of the file being downloaded.
+    /// The bytes at `offset` of the file being downloaded (right after the previous ones).
     pub fn write(&mut self, offset: usize, data: &[u8]) -> Result<(), SlotError> {
-        let slot = self.writing.ok_or(SlotError::Device)?;
+        let mut w = self.writing.ok_or(SlotError::Device)?;
+        if offset != w.len || w.ended {
+            return Err(SlotError::OutOfOrder);
+        }
         if offset.saturating_add(data.len()) > FILE_MAX {
             return Err(SlotError::TooLong);
         }
-        self.storage.write((slot * SLOT + HEADER + offset) as u32, data).map_err(|_| SlotError::Device)
+        for &byte in data {
+            if let Some(b) = w.block.get_mut(w.len % WRITE_BLOCK) {
+                *b = byte;
+            }
+            w.len += 1;
+            if w.len % WRITE_BLOCK == 0 {
+                self.write_block(&mut w)?;
+            }
+        }
+        self.writing = Some(w);
+        Ok(())
     }
 
-    /// The downloaded file (`len` bytes) as stored, to be checked.
-    pub fn downloaded(&self, len: usize) -> Option<&[u8]> {
-        self.file(self.writing?, len)
+    /// The block the file's bytes up to `w.len` end in, written and started afresh.
+    fn write_block(&mut self, w: &mut Writing) -> Result<(), SlotError> {
+        let start = (w.len - 1) / WRITE_BLOCK * WRITE_BLOCK;
+        let at = w.slot * SLOT + HEADER + start;
+        let block = core::mem::replace(&mut w.block, [ERASED; WRITE_BLOCK]);
+        self.memory.write(at as u32, &block).map_err(|_| SlotError::Device)
+    }
+
+    /// The downloaded file, its last block written out, as stored: to be checked.
+    pub fn downloaded(&mut self) -> Option<&[u8]> {
+        let mut w = self.writing?;
+        if w.len % WRITE_BLOCK != 0 && !w.ended {
+            // The block's rest stays erased.
+            self.write_block(&mut w).ok()?;
+        }
+        w.ended = true;
+        self.writing = Some(w);
+        self.file(w.slot, w.len)
     }
 
     /// The downloaded file of `len` bytes becomes the active one: its header is written.
     pub fn commit(&mut self, len: usize, crc: u16) -> Result<(), SlotError> {
-        let slot = self.writing.take().ok_or(SlotError::Device)?;
+        let w = self.writing.take().ok_or(SlotError::Device)?;
         let sequence = self.newest().map_or(0, |(_, h)| h.sequence.wrapping_add(1));
         let header = Header { sequence, len: len as u32, crc };
-        self.storage.write((slot * SLOT) as u32, &header.encode()).map_err(|_| SlotError::Device)
+        self.memory.write((w.slot * SLOT) as u32, &header.encode()).map_err(|_| SlotError::Device)
     }
 
     /// The download ended without a file: its slot keeps no header.
     pub fn discard(&mut self) {
         self.writing = None;
     }
-}
 
-impl<M: MappedStorage> ConfigSlots<M> {
-    /// No file any more (1F51h.1 = 3, clear): both headers are cleared.
+    /// No file any more (1F51h.1 = 3, clear): both slots are erased.
     pub fn clear(&mut self) -> Result<(), SlotError> {
         self.writing = None;
-        for slot in 0..2 {
-            self.storage.write((slot * SLOT) as u32, &[0; HEADER]).map_err(|_| SlotError::Device)?;
-        }
-        Ok(())
+        self.memory.erase(0, Self::CAPACITY as u32).map_err(|_| SlotError::Device)
     }
 }
 
@@ -179,8 +219,101 @@ impl Storage for NoMemory {
     }
 }
 
-impl MappedStorage for NoMemory {
+impl ConfigMemory for NoMemory {
     fn mapped(&self) -> &[u8] {
         &[]
+    }
+    fn erase(&mut self, _: u32, _: u32) -> Result<(), SlotError> {
+        Err(SlotError::Device)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec;
+
+    /// Flash as an MCU has it: erase sets 0xFF, a write may only program erased bytes, in
+    /// aligned blocks of `WRITE_BLOCK`.
+    #[derive(Debug)]
+    struct Flash {
+        bytes: std::vec::Vec<u8>,
+        erases: usize,
+    }
+
+    impl embedded_storage::ReadStorage for Flash {
+        type Error = SlotError;
+        fn read(&mut self, offset: u32, out: &mut [u8]) -> Result<(), SlotError> {
+            out.copy_from_slice(&self.bytes[offset as usize..offset as usize + out.len()]);
+            Ok(())
+        }
+        fn capacity(&self) -> usize {
+            self.bytes.len()
+        }
+    }
+
+    impl Storage for Flash {
+        fn write(&mut self, offset: u32, data: &[u8]) -> Result<(), SlotError> {
+            let at = offset as usize;
+            assert_eq!(at % WRITE_BLOCK, 0, "aligned");
+            assert_eq!(data.len() % WRITE_BLOCK, 0, "whole blocks");
+            let cells = &mut self.bytes[at..at + data.len()];
+            assert!(cells.iter().all(|&b| b == ERASED), "programs erased bytes only, at {at}");
+            cells.copy_from_slice(data);
+            Ok(())
+        }
+    }
+
+    impl ConfigMemory for Flash {
+        fn mapped(&self) -> &[u8] {
+            &self.bytes
+        }
+        fn erase(&mut self, offset: u32, len: u32) -> Result<(), SlotError> {
+            assert_eq!((offset as usize % SLOT, len as usize % SLOT), (0, 0), "whole slots");
+            self.bytes[offset as usize..(offset + len) as usize].fill(ERASED);
+            self.erases += 1;
+            Ok(())
+        }
+    }
+
+    fn download(slots: &mut ConfigSlots<Flash>, file: &[u8], part: usize) {
+        slots.begin().unwrap();
+        for (i, chunk) in file.chunks(part).enumerate() {
+            slots.write(i * part, chunk).unwrap();
+        }
+    }
+
+    #[test]
+    fn files_alternate_between_the_slots_and_program_flash_only_where_erased() {
+        let mut slots = ConfigSlots::new(Flash { bytes: vec![0; ConfigSlots::<Flash>::CAPACITY], erases: 0 });
+        assert_eq!(slots.active(), None, "never-erased memory holds no file");
+        for (n, len) in [(1_u8, 2217), (2, 7), (3, FILE_MAX), (4, 9)] {
+            let file: std::vec::Vec<u8> = (0..len).map(|i| (i as u8).wrapping_mul(n)).collect();
+            // Segments of 7 bytes, as a segmented SDO download brings them.
+            download(&mut slots, &file, 7);
+            assert_eq!(slots.downloaded(), Some(&file[..]));
+            assert_ne!(slots.active(), Some(&file[..]), "not active before the commit");
+            slots.commit(len, 0).unwrap();
+            assert_eq!(slots.active(), Some(&file[..]));
+        }
+        assert_eq!(slots.memory().erases, 4);
+    }
+
+    #[test]
+    fn a_cut_download_leaves_the_active_file_and_out_of_order_parts_are_refused() {
+        let mut slots = ConfigSlots::new(Flash { bytes: vec![ERASED; ConfigSlots::<Flash>::CAPACITY], erases: 0 });
+        let first = [1_u8; 100];
+        download(&mut slots, &first, 7);
+        slots.downloaded();
+        slots.commit(first.len(), 0).unwrap();
+        download(&mut slots, &[2; 50], 7);
+        slots.discard();
+        assert_eq!(slots.active(), Some(&first[..]));
+        slots.begin().unwrap();
+        assert_eq!(slots.write(7, &[0; 7]), Err(SlotError::OutOfOrder));
+        assert_eq!(slots.write(0, &[0; FILE_MAX + 1]), Err(SlotError::TooLong));
+        slots.clear().unwrap();
+        assert_eq!(slots.active(), None);
     }
 }
