@@ -42,6 +42,15 @@ impl Bench {
         bench
     }
 
+    /// A coprocessor running coforge's own file for `node_id`.
+    fn with_own_file(name: &str, node_id: u8) -> Self {
+        let mut b = Bench::new(name);
+        b.enter_bootloader(FIRMWARE_ID);
+        b.download(BOOTLOADER, &own_file(node_id), None).unwrap();
+        b.start_application(node_id);
+        b
+    }
+
     /// Power-on from what the memory files hold (a power cut is: drop the device, power on).
     fn power_on(&mut self) {
         let ia = DeviceKind::find("canopenia").unwrap().create(None, FIRMWARE_ID, &self.store).unwrap();
@@ -170,10 +179,7 @@ fn a_file_from_coforge_beds_is_loaded_and_runs() {
 
 #[test]
 fn corrupt_files_are_refused_and_change_nothing() {
-    let mut b = Bench::new("corrupt");
-    b.enter_bootloader(FIRMWARE_ID);
-    b.download(BOOTLOADER, &own_file(5), None).unwrap();
-    b.start_application(5);
+    let mut b = Bench::with_own_file("corrupt", 5);
     b.enter_bootloader(5);
     let good = own_file(6);
     // A flipped bit (CRC), a cut file, a file longer than a slot.
@@ -190,10 +196,7 @@ fn corrupt_files_are_refused_and_change_nothing() {
 
 #[test]
 fn a_power_cut_during_the_download_leaves_the_previous_file() {
-    let mut b = Bench::new("cut");
-    b.enter_bootloader(FIRMWARE_ID);
-    b.download(BOOTLOADER, &own_file(5), None).unwrap();
-    b.start_application(5);
+    let mut b = Bench::with_own_file("cut", 5);
     b.enter_bootloader(5);
     b.download(BOOTLOADER, &own_file(6), Some(100)).unwrap();
     b.power_on();
