@@ -226,11 +226,7 @@ impl<S: ParamStore, M: ConfigMemory> Canopenia<S, M> {
         let mut failed = 0_u32;
         if let Some(file) = checked_active(&slots, entries) {
             let node = &mut self.node;
-            apply::apply(&file, entries, area, node_id, &mut |index, sub, data| {
-                if node.write(index, sub, data, Side::Device).is_err() {
-                    failed += 1;
-                }
-            });
+            failed = apply::apply(&file, entries, area, node_id, &mut |index, sub, data| node.write(index, sub, data, Side::Device).is_ok());
             self.node.reload_stored(area);
         }
         self.node.od_mut().app.program.give_back(slots);

@@ -38,8 +38,8 @@ fn from_bus(by: WriteSource) -> bool {
     matches!(by, WriteSource::Sdo | WriteSource::Rpdo)
 }
 
-/// Whether the device acts on writes of this entry, whoever writes it.
-fn is_command_entry(index: u16, sub: u8) -> bool {
+/// Whether the device acts on writes of this entry (whoever writes it but the device itself).
+pub(crate) fn is_command_entry(index: u16, sub: u8) -> bool {
     matches!((index, sub), (index::NMT_MASTER_MESSAGE, 1) | (index::DEVICE_CONTROL, 1 | 0x0A))
 }
 

@@ -1,5 +1,7 @@
 //! A checked binary EDS as writes into the dictionary: the values of its entries, then its
-//! PDO configuration, for the entries of one reset area. The device writes them with its own
+//! PDO configuration, for the entries of one reset area. Not configuration, and not written:
+//! sub-index 0 of arrays and records, the loading interface, what the chip owns or the firmware
+//! serves, and the command entries the device acts on (5F01h.1, 5F01h.0A, 5F0Ah.1). The device writes them with its own
 //! rights after every initialisation, before what 1010h saved is loaded over them.
 
 use super::check::{SERVED_BY_FIRMWARE, mapped};
@@ -14,30 +16,57 @@ const NOT_CONFIGURATION: [u16; 3] = [SERVED_BY_FIRMWARE, 0x1F50, 0x1F51];
 /// activation key) and its chip ID (5F00h.5).
 const CHIP_OWN: [(u16, u8); 2] = [(0x1018, 4), (0x5F00, 5)];
 const RPDO_COMM: u16 = 0x1400;
+/// RPDO and TPDO communication and mapping parameters.
+const PDO_PARAMETERS: core::ops::RangeInclusive<u16> = 0x1400..=0x1BFF;
 const TPDO_COMM: u16 = 0x1800;
 const MAPPING: u16 = 0x200;
 /// COB-ID bit 31: the PDO does not exist (is not valid).
 const PDO_INVALID: u32 = 1 << 31;
 
+/// Writes each entry's value (`write` says whether the dictionary took it).
+pub type Write<'w> = dyn FnMut(u16, u8, &[u8]) -> bool + 'w;
+
 /// Calls `write` with every value of `file` for the entries of `area`, in an order the
-/// dictionary's PDO rules accept.
-pub fn apply(file: &BinaryEds<'_>, entries: &[EntryInfo], area: Area, node_id: u8, write: &mut dyn FnMut(u16, u8, &[u8])) {
+/// dictionary's PDO rules accept; the number of values the dictionary refused.
+///
+/// The format stores 0 in the process image where a default depends on the node-ID or is
+/// absent (erratum COIA-39): a zero the dictionary refuses is that, not a refused value.
+pub fn apply(file: &BinaryEds<'_>, entries: &[EntryInfo], area: Area, node_id: u8, write: &mut Write<'_>) -> u32 {
+    let mut refused = 0;
+    let mut value = |index: u16, sub: u8, data: &[u8]| {
+        if !write(index, sub, data) && data.iter().any(|&b| b != 0) {
+            refused += 1;
+        }
+    };
+    // PDO parameters are written in the PDO step, in the order CiA 301 accepts (and the
+    // file's image holds node-relative COB-IDs as 0: the PDO records have them absolute).
     let wanted = |index: u16, sub: u8| {
-        area.contains(index) && !NOT_CONFIGURATION.contains(&index) && !CHIP_OWN.contains(&(index, sub)) && !is_structure(entries, index, sub)
+        area.contains(index)
+            && !PDO_PARAMETERS.contains(&index)
+            && !NOT_CONFIGURATION.contains(&index)
+            && !CHIP_OWN.contains(&(index, sub))
+            && !crate::objects::is_command_entry(index, sub)
+            && !is_structure(entries, index, sub)
     };
     for r in file.sdo_replies().filter(|r| wanted(r.index, r.sub)) {
-        write(r.index, r.sub, r.value());
+        value(r.index, r.sub, r.value());
     }
     for e in file.od_entries().filter(|e| wanted(e.index, e.sub)) {
-        write(e.index, e.sub, file.image_value(Table::Defaults, e.offset, e.size()));
+        value(e.index, e.sub, file.image_value(Table::Defaults, e.offset, e.size()));
     }
     for e in file.generic_entries().filter(|e| wanted(e.index, e.sub)) {
-        write(e.index, e.sub, file.image_value(Table::Defaults, e.offset, e.size));
+        value(e.index, e.sub, file.image_value(Table::Defaults, e.offset, e.size));
     }
     if area.contains(RPDO_COMM) {
-        pdos(file, entries, Table::Rpdos, RPDO_COMM, node_id, write);
-        pdos(file, entries, Table::Tpdos, TPDO_COMM, node_id, write);
+        let mut counted = |index: u16, sub: u8, data: &[u8]| {
+            if !write(index, sub, data) {
+                refused += 1;
+            }
+        };
+        pdos(file, entries, Table::Rpdos, RPDO_COMM, node_id, &mut counted);
+        pdos(file, entries, Table::Tpdos, TPDO_COMM, node_id, &mut counted);
     }
+    refused
 }
 
 /// Sub-index 0 of an array or record: the dictionary's structure, not a value to take.
