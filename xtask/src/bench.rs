@@ -32,6 +32,8 @@ pub const BENCHES: &[Bench] = &[
     // Not a device: the manager of coforge-stack, which CANopenIA runs.
     Bench { image: "bench-manager", device: "manager", title: "coforge-stack manager (127 nodes monitored, 31 scans cached)" },
     Bench { image: "bench-canopenia", device: "canopenia", title: "CANopenIA (remote access, 8 scans cached)" },
+    // Not an image of its own: CANopenIA's start with a loaded configuration file.
+    Bench { image: "bench-canopenia-config", device: "canopenia-config", title: "CANopenIA with the vendor's CiA 401 file loaded" },
 ];
 /// A run takes well under a second; this only stops a hung image.
 const QEMU_TIMEOUT: Duration = Duration::from_secs(120);

@@ -101,6 +101,10 @@ impl<M: ConfigMemory> ConfigSlots<M> {
         &self.memory
     }
 
+    pub fn into_memory(self) -> M {
+        self.memory
+    }
+
     fn header(&self, slot: usize) -> Option<Header> {
         let at = slot * SLOT;
         Header::decode(self.memory.mapped().get(at..at + HEADER)?.try_into().ok()?)
@@ -195,6 +199,19 @@ impl<M: ConfigMemory> ConfigSlots<M> {
     pub fn clear(&mut self) -> Result<(), SlotError> {
         self.writing = None;
         self.memory.erase(0, Self::CAPACITY as u32).map_err(|_| SlotError::Device)
+    }
+}
+
+/// A RAM image (an EEPROM's, a test's) as configuration memory.
+impl<B: AsRef<[u8]> + AsMut<[u8]>> ConfigMemory for coforge_storage::ram::RamEeprom<B> {
+    fn mapped(&self) -> &[u8] {
+        self.as_bytes()
+    }
+
+    fn erase(&mut self, offset: u32, len: u32) -> Result<(), Self::Error> {
+        let start = offset as usize;
+        self.as_bytes_mut().get_mut(start..start + len as usize).ok_or(coforge_storage::ram::OutOfBounds)?.fill(ERASED);
+        Ok(())
     }
 }
 
