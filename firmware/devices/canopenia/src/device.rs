@@ -56,7 +56,7 @@ use coforge_stack::manager::scan::{MAX_MAPPED, ScanConfig, ScanEvent};
 use coforge_stack::manager::{Manager, ManagerEvent, nmt_frame};
 use coforge_stack::nmt::{NmtCommand, state_code};
 use coforge_stack::node::{BusState, NodeEvent};
-use coforge_stack::od::{Area, NodeDictionary, Side};
+use coforge_stack::od::{Area, EntryAccess, NodeDictionary, Side};
 use coforge_stack::sdo::client::{SdoResult, StartError};
 use coforge_stack::store::{BlockStore, ParamStore};
 use heapless::Deque;
@@ -225,8 +225,10 @@ impl<S: ParamStore, M: ConfigMemory> Canopenia<S, M> {
         let node_id = self.node.node_id();
         let mut failed = 0_u32;
         if let Some(file) = checked_active(&slots, entries) {
-            let node = &mut self.node;
-            failed = apply::apply(&file, entries, area, node_id, &mut |index, sub, data| node.write(index, sub, data, Side::Device).is_ok());
+            // Straight into the dictionary (lengths and limits checked): the services are
+            // reloaded from it once, after all of them, not after each.
+            let od = self.node.od_mut();
+            failed = apply::apply(&file, entries, area, node_id, &mut |index, sub, data| od.entry(index, sub).and_then(|info| od.write_entry(info, index, sub, data)).is_ok());
             self.node.reload_stored(area);
         }
         self.node.od_mut().app.program.give_back(slots);
