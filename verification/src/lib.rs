@@ -13,6 +13,7 @@
 
 pub mod banks;
 pub mod canopenia;
+pub mod canopenia_files;
 pub mod framing;
 pub mod gw1;
 pub mod inputs;

@@ -187,7 +187,7 @@ fn test() -> Result {
 
 /// The fuzz targets in `verification/fuzz` (one per streaming decoder).
 const FUZZ_TARGETS: &[&str] =
-    &["nibble_decoder", "length_byte_decoder", "start_crc_decoder", "node_frames", "gw1_inputs", "manager_inputs", "canopenia_inputs"];
+    &["nibble_decoder", "length_byte_decoder", "start_crc_decoder", "node_frames", "gw1_inputs", "manager_inputs", "canopenia_inputs", "canopenia_config_file"];
 
 /// Runs each fuzz target for `FUZZ_SECONDS` (default 20) seconds; a crash fails the run.
 fn fuzz() -> Result {
