@@ -228,7 +228,9 @@ impl<S: ParamStore, M: ConfigMemory> Canopenia<S, M> {
             // Straight into the dictionary (lengths and limits checked): the services are
             // reloaded from it once, after all of them, not after each.
             let od = self.node.od_mut();
-            failed = apply::apply(&file, entries, area, node_id, &mut |index, sub, data| od.entry(index, sub).and_then(|info| od.write_entry(info, index, sub, data)).is_ok());
+            failed = apply::apply(&file, entries, area, node_id, &mut |index, sub, data| {
+                od.entry(index, sub).and_then(|info| od.write_entry(info, index, sub, data)).is_ok()
+            });
             self.node.reload_stored(area);
         }
         self.node.od_mut().app.program.give_back(slots);
