@@ -128,7 +128,8 @@ enum Cmd {
         #[arg(long)]
         mode: Option<String>,
         /// Keep stored parameters (1010h) in this file instead of in memory (CO401Memory1:
-        /// its banks in FILE.bank1 and FILE.bank2).
+        /// its banks in FILE.bank1 and FILE.bank2; CANopenIA: its loaded configuration files in
+        /// FILE.configuration).
         #[arg(long)]
         store: Option<PathBuf>,
         /// Serve the first node's serial host interface on this TCP port (0 picks a free
