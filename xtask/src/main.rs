@@ -130,6 +130,7 @@ fn test() -> Result {
     setup::rust_targets()?;
     setup::rust_components()?;
     let python = setup::python_venv()?;
+    setup::card_tools()?;
 
     println!("xtask: [1/8] formatting and lints");
     run(cargo().args(["fmt", "--all", "--check"]))?;

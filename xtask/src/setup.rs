@@ -73,6 +73,15 @@ pub fn qemu() -> Result {
     Ok(())
 }
 
+/// mtools and dosfstools, the tools a PC reads a card with: the CR3101 card tests check what
+/// the firmware wrote with `mcopy`/`mdir` and `fsck.fat`.
+pub fn card_tools() -> Result {
+    if output(Command::new("sh").args(["-c", "command -v mdir && command -v mcopy && command -v fsck.fat"])).is_none() {
+        apt_install(&["mtools", "dosfstools"], "mtools and fsck.fat read and check the CR3101 card images the tests write")?;
+    }
+    Ok(())
+}
+
 /// `.venv` with the Python test peers from `tests/python/requirements.txt`.
 pub fn python_venv() -> Result<PathBuf> {
     let venv = root().join(".venv");

@@ -16,6 +16,7 @@
 
 pub mod app;
 pub mod canopenia;
+pub mod card;
 pub mod devices;
 pub mod gw1;
 pub mod hub;
