@@ -166,6 +166,19 @@ enum Cmd {
         #[arg(long)]
         seconds: Option<u64>,
     },
+    /// Make a new memory card image for CR3101 (the simulator's card, QEMU's
+    /// `-drive if=sd,format=raw,file=FILE`): an MBR with one FAT16 partition from 1 MiB on, as a
+    /// PC formats a card. A PC reads it with `mdir -i FILE@@1M ::`.
+    Card {
+        /// The image file to write (replaced if it exists).
+        file: PathBuf,
+        /// Size in MiB: a power of two from 16 to 2048 (QEMU's SD card needs a power of two).
+        #[arg(long, default_value_t = 16)]
+        mib: u64,
+        /// The volume label (up to 11 characters; 2000h holds the card's name).
+        #[arg(long, default_value = "CANMEM")]
+        label: String,
+    },
     /// Talk to a CANopen bus through a bus hub (`coforge sim`, `coforge hub`): scan the nodes,
     /// read and write their dictionaries, send NMT commands, watch heartbeats and emergencies.
     Master {
@@ -359,6 +372,12 @@ fn hub(port: u16, adapters: &[String], seconds: Option<u64>) -> Result<ExitCode,
 fn run(cmd: Cmd) -> Result<ExitCode, String> {
     match cmd {
         Cmd::Hub { port, connect, seconds } => hub(port, &connect, seconds),
+        Cmd::Card { file, mib, label } => coforge_sim::card::CardImage::create(&file, mib << 20, &label)
+            .map(|_| {
+                println!("coforge card: {} ({mib} MiB, FAT16 from 1 MiB, label {label})", file.display());
+                ExitCode::SUCCESS
+            })
+            .map_err(|e| format!("{}: {e}", file.display())),
         Cmd::Master { port, timeout_ms, cmd } => master::run(&port, timeout_ms, cmd),
         Cmd::Sim { device, node_id, port, mode, store, nodes, connect, seconds, serial, enable_can } => sim(SimArgs {
             device: &device,

@@ -158,12 +158,17 @@ fn test() -> Result {
     let qemu_image = root().join("target/dist/images/co401memory1-qemu.bin");
     let gw1_qemu_image = root().join("target/dist/images/co401gw1-qemu.bin");
     let ia_qemu_image = root().join("target/dist/images/canopenia-qemu.bin");
+    // CR3101's card layer on QEMU's SD card: a test fixture until the device's image exists.
+    let qemu_board = root().join("firmware/boards/qemu");
+    run(cargo().args(["build", "--quiet", "--release", "--target", "thumbv7m-none-eabi", "--bin", "cr3101-card"]).current_dir(&qemu_board))?;
+    let card_qemu_image = qemu_board.join("target/thumbv7m-none-eabi/release/cr3101-card");
     let status = Command::new(&python)
         .args(["-m", "pytest", "-q", "tests/python"])
         .env("COFORGE_BIN", &coforge)
         .env("COFORGE_QEMU_IMAGE", &qemu_image)
         .env("COFORGE_GW1_QEMU_IMAGE", &gw1_qemu_image)
         .env("COFORGE_IA_QEMU_IMAGE", &ia_qemu_image)
+        .env("COFORGE_CARD_QEMU_IMAGE", &card_qemu_image)
         .current_dir(root())
         .status()
         .map_err(|e| format!("cannot run pytest: {e}"))?;

@@ -1,7 +1,7 @@
 //! The lm3s6965evb board as QEMU emulates it: a millisecond clock from SysTick, the UARTs
 //! the images use, banks kept in host files through semihosting, the main loop every image
 //! runs its device in (`serve`, generic over the device contract), a line console for a
-//! third UART, and what the bench images share (`bench`). The devices are the device crates';
+//! third UART, the SD card on SSI0 (`sd`), and what the bench images share (`bench`). The devices are the device crates';
 //! each image builds its own.
 #![no_std]
 
@@ -9,5 +9,6 @@ pub mod bench;
 pub mod clock;
 pub mod host_file;
 pub mod line_console;
+pub mod sd;
 pub mod serve;
 pub mod uart;

@@ -1,0 +1,76 @@
+//! CR3101's card layer on QEMU's SD card (`-drive if=sd,format=raw,file=card.img`): mounts the
+//! card through `embedded-sdmmc` on SSI0, lays out two data files, writes 200 records into the
+//! first, reads one back, unmounts and exits 0 through semihosting (1 on any failure, with the
+//! reason). `tests/python/test_cr3101_card.py` then reads the card with mtools and checks it
+//! with `fsck.fat -n`. A fixture for the card layer until the CR3101 device image exists.
+#![no_std]
+#![no_main]
+
+use coforge_board_qemu::sd::{SdSpi, SpinDelay};
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use cr3101::card::files::Card;
+use cr3101::card::record::{ComponentType, Record, RecordLayout, TimeStamp};
+use embedded_sdmmc::{SdCard, TimeSource, Timestamp};
+use panic_semihosting as _;
+
+/// 2026-12-03 06:30:00, as the test expects in the directory entries.
+struct Clock;
+
+impl TimeSource for Clock {
+    fn get_timestamp(&self) -> Timestamp {
+        Timestamp { year_since_1970: 56, zero_indexed_month: 11, zero_indexed_day: 2, hours: 6, minutes: 30, seconds: 0 }
+    }
+}
+
+/// The records' layout: component 1 WORD, component 2 DINT, component 4 BYTE (16 bytes).
+fn layout() -> RecordLayout {
+    let mut l = RecordLayout { relevant: 0b0000_1011, ..RecordLayout::default() };
+    l.types[1] = ComponentType::Dint;
+    l.types[3] = ComponentType::Byte;
+    l
+}
+
+/// Record `n`: the same values the test computes.
+fn record(n: u32) -> Record {
+    let l = layout();
+    let mut r = Record::new(&l);
+    r.set(&l, 0, &(n as u16).to_le_bytes());
+    r.set(&l, 1, &(-(n as i32) * 1000).to_le_bytes());
+    r.set(&l, 3, &[(n % 251) as u8]);
+    r.stamp(&TimeStamp { millisecond: (n % 1000) as u16, second: (n % 60) as u8, minute: 30, hour: 6, day: 3, month: 12, year: 26 });
+    r
+}
+
+fn fail(what: &str) -> ! {
+    hprintln!("cr3101-card: {}", what);
+    debug::exit(debug::EXIT_FAILURE);
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let sd = SdCard::new(SdSpi::new(), SpinDelay);
+    let Ok(mut card) = Card::mount(sd, Clock) else { fail("mount") };
+    let len = layout().len() as u32;
+    if card.lay_out(0, "OIL_TEMP.DAT", 200 * len).is_err() || card.lay_out(2, "PRESS.DAT", 4096).is_err() {
+        fail("lay out");
+    }
+    for n in 0..200 {
+        if card.write_at(0, n * len, record(n).as_bytes()).is_err() {
+            fail("write a record");
+        }
+    }
+    let mut back = [0_u8; 16];
+    if card.read_at(0, 123 * len, &mut back).is_err() || Record::from_bytes(&layout(), &back) != Some(record(123)) {
+        fail("read record 123 back");
+    }
+    let _ = card.unmount();
+    hprintln!("cr3101-card: 200 records written");
+    debug::exit(debug::EXIT_SUCCESS);
+    loop {
+        cortex_m::asm::wfi();
+    }
+}

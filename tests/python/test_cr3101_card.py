@@ -1,0 +1,52 @@
+"""CR3101's card layer on QEMU's emulated SD card (lm3s6965evb, SSI0, card select on GPIO D0):
+`coforge card` makes a card image as a PC formats one, the `cr3101-card` image (path in
+COFORGE_CARD_QEMU_IMAGE) mounts it through embedded-sdmmc, lays out two data files and writes
+200 records, and then tools we did not write read it: mtools byte for byte, `fsck.fat -n`
+clean. The record layout is the README's (time stamp, modification status, components).
+"""
+
+import os
+import pathlib
+import shutil
+import struct
+import subprocess
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
+IMAGE = os.environ.get("COFORGE_CARD_QEMU_IMAGE", str(ROOT / "firmware/boards/qemu/target/thumbv7m-none-eabi/release/cr3101-card"))
+MTOOLS = dict(os.environ, MTOOLS_SKIP_CHECK="1")
+
+
+def record(n):
+    """Record n as the image writes it: component 1 WORD, 2 DINT, 4 BYTE (bitmap 0Bh)."""
+    stamp = struct.pack("<HBBBBBB", n % 1000, n % 60, 30, 6, 3, 12, 26)
+    return stamp + bytes([0b1011]) + struct.pack("<Hi", n & 0xFFFF, -n * 1000) + bytes([n % 251])
+
+
+def test_records_on_the_emulated_sd_card_read_back_with_mtools_and_fsck_clean(tmp_path):
+    assert pathlib.Path(IMAGE).exists(), f"no card image at {IMAGE}: cargo xtask test builds it"
+    for tool in ("mdir", "mcopy", "fsck.fat"):
+        assert shutil.which(tool), f"{tool} is missing: cargo xtask test installs mtools and dosfstools"
+    card = tmp_path / "card.img"
+    subprocess.run([COFORGE, "card", card, "--mib", "16", "--label", "CANMEM"], check=True, timeout=60)
+    run = subprocess.run(
+        ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", "none",
+         "-semihosting-config", "enable=on,target=native", "-kernel", IMAGE,
+         "-drive", f"if=sd,format=raw,file={card}"],
+        stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=120,
+    )
+    assert run.returncode == 0, f"the image failed: {run.stdout}{run.stderr}"
+    assert "200 records written" in run.stdout
+
+    listing = subprocess.run(["mdir", "-i", f"{card}@@1M", "-b", "::"], env=MTOOLS, check=True, capture_output=True, text=True).stdout
+    assert "OIL_TEMP.DAT" in listing and "PRESS.DAT" in listing, listing
+    out = tmp_path / "OIL_TEMP.DAT"
+    subprocess.run(["mcopy", "-n", "-i", f"{card}@@1M", "::OIL_TEMP.DAT", out], env=MTOOLS, check=True)
+    assert out.read_bytes() == b"".join(record(n) for n in range(200))
+
+    partition = tmp_path / "partition.img"
+    partition.write_bytes(card.read_bytes()[1 << 20:])
+    fsck = subprocess.run(["fsck.fat", "-n", partition], capture_output=True, text=True)
+    assert fsck.returncode == 0, fsck.stdout + fsck.stderr
