@@ -2,7 +2,9 @@
 `coforge card` makes a card image as a PC formats one, the `cr3101-card` image (path in
 COFORGE_CARD_QEMU_IMAGE) mounts it through embedded-sdmmc, lays out two data files and writes
 200 records, and then tools we did not write read it: mtools byte for byte, `fsck.fat -n`
-clean. The record layout is the README's (time stamp, modification status, components).
+clean. The record layout is the README's (time stamp, modification status, components). The
+power is also cut (QEMU killed) while it logs, at several points: the card stays clean and every
+record written before the cut reads back.
 """
 
 import os
@@ -25,28 +27,65 @@ def record(n):
     return stamp + bytes([0b1011]) + struct.pack("<Hi", n & 0xFFFF, -n * 1000) + bytes([n % 251])
 
 
-def test_records_on_the_emulated_sd_card_read_back_with_mtools_and_fsck_clean(tmp_path):
+def new_card(tmp_path):
     assert pathlib.Path(IMAGE).exists(), f"no card image at {IMAGE}: cargo xtask test builds it"
     for tool in ("mdir", "mcopy", "fsck.fat"):
         assert shutil.which(tool), f"{tool} is missing: cargo xtask test installs mtools and dosfstools"
     card = tmp_path / "card.img"
     subprocess.run([COFORGE, "card", card, "--mib", "16", "--label", "CANMEM"], check=True, timeout=60)
-    run = subprocess.run(
-        ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", "none",
-         "-semihosting-config", "enable=on,target=native", "-kernel", IMAGE,
-         "-drive", f"if=sd,format=raw,file={card}"],
-        stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=120,
-    )
+    return card
+
+
+def qemu(card):
+    return ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", "none",
+            "-semihosting-config", "enable=on,target=native", "-kernel", IMAGE,
+            "-drive", f"if=sd,format=raw,file={card}"]
+
+
+def copy_out(card, tmp_path, name):
+    out = tmp_path / name
+    subprocess.run(["mcopy", "-o", "-n", "-i", f"{card}@@1M", f"::{name}", out], env=MTOOLS, check=True)
+    return out.read_bytes()
+
+
+def fsck_clean(card, tmp_path):
+    partition = tmp_path / "partition.img"
+    partition.write_bytes(card.read_bytes()[1 << 20:])
+    fsck = subprocess.run(["fsck.fat", "-n", partition], capture_output=True, text=True)
+    return fsck.returncode == 0, fsck.stdout + fsck.stderr
+
+
+def test_records_on_the_emulated_sd_card_read_back_with_mtools_and_fsck_clean(tmp_path):
+    card = new_card(tmp_path)
+    run = subprocess.run(qemu(card), stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, f"the image failed: {run.stdout}{run.stderr}"
     assert "200 records written" in run.stdout
 
     listing = subprocess.run(["mdir", "-i", f"{card}@@1M", "-b", "::"], env=MTOOLS, check=True, capture_output=True, text=True).stdout
     assert "OIL_TEMP.DAT" in listing and "PRESS.DAT" in listing, listing
-    out = tmp_path / "OIL_TEMP.DAT"
-    subprocess.run(["mcopy", "-n", "-i", f"{card}@@1M", "::OIL_TEMP.DAT", out], env=MTOOLS, check=True)
-    assert out.read_bytes() == b"".join(record(n) for n in range(200))
+    assert copy_out(card, tmp_path, "OIL_TEMP.DAT") == b"".join(record(n) for n in range(200))
+    clean, report = fsck_clean(card, tmp_path)
+    assert clean, report
 
-    partition = tmp_path / "partition.img"
-    partition.write_bytes(card.read_bytes()[1 << 20:])
-    fsck = subprocess.run(["fsck.fat", "-n", partition], capture_output=True, text=True)
-    assert fsck.returncode == 0, fsck.stdout + fsck.stderr
+
+@pytest.mark.parametrize("cut_after", [0, 57, 150])
+def test_a_power_cut_while_logging_leaves_the_card_clean_and_every_record_before_it(tmp_path, cut_after):
+    card = new_card(tmp_path)
+    proc = subprocess.Popen(qemu(card), stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        for line in proc.stdout:
+            if line.strip() == f"record {cut_after}":
+                break
+        else:
+            pytest.fail(f"the image ended before record {cut_after}")
+        proc.kill()  # the power goes: nothing is closed or flushed
+    finally:
+        proc.kill()
+        proc.wait(timeout=10)
+        proc.stdout.close()
+    clean, report = fsck_clean(card, tmp_path)
+    assert clean, report
+    logged = copy_out(card, tmp_path, "OIL_TEMP.DAT")
+    done = b"".join(record(n) for n in range(cut_after + 1))
+    assert logged[: len(done)] == done, "every record written before the cut"
+    assert len(logged) == 200 * len(record(0)), "the file keeps its pre-allocated size"

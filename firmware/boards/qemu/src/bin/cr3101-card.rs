@@ -1,7 +1,7 @@
 //! CR3101's card layer on QEMU's SD card (`-drive if=sd,format=raw,file=card.img`): mounts the
 //! card through `embedded-sdmmc` on SSI0, lays out two data files, writes 200 records into the
-//! first, reads one back, unmounts and exits 0 through semihosting (1 on any failure, with the
-//! reason). `tests/python/test_cr3101_card.py` then reads the card with mtools and checks it
+//! first (saying `record n` after each, so a test can cut the power at a known point), reads
+//! one back, unmounts and exits 0 through semihosting (1 on any failure, with the reason). `tests/python/test_cr3101_card.py` then reads the card with mtools and checks it
 //! with `fsck.fat -n`. A fixture for the card layer until the CR3101 device image exists.
 #![no_std]
 #![no_main]
@@ -58,10 +58,12 @@ fn main() -> ! {
     if card.lay_out(0, "OIL_TEMP.DAT", 200 * len).is_err() || card.lay_out(2, "PRESS.DAT", 4096).is_err() {
         fail("lay out");
     }
+    hprintln!("cr3101-card: laid out");
     for n in 0..200 {
         if card.write_at(0, n * len, record(n).as_bytes()).is_err() {
             fail("write a record");
         }
+        hprintln!("record {}", n);
     }
     let mut back = [0_u8; 16];
     if card.read_at(0, 123 * len, &mut back).is_err() || Record::from_bytes(&layout(), &back) != Some(record(123)) {

@@ -1,11 +1,12 @@
 //! The card's files: an MBR-partitioned FAT16/FAT32 volume through `embedded-sdmmc`, with one
 //! data file per configured file, named by 3x00h (8.3) and pre-allocated at its 2002h size.
 //!
-//! Logging rewrites the bytes of a pre-allocated file in place: the clusters, and so the FAT,
-//! never change while logging, and the files stay open, so their directory entries are not
-//! rewritten either (`embedded-sdmmc` updates an entry when its file is closed). A power loss
-//! can only cut the sector being written. Files on the card that are not the device's are left
-//! alone.
+//! Laying out a file writes its clusters, then its directory entry with the whole size.
+//! Logging then rewrites the bytes of the pre-allocated file in place: the clusters, and so the
+//! FAT, never change while logging, and the files stay open, so their directory entries are
+//! not rewritten either (`embedded-sdmmc` writes an entry when its file is flushed or closed).
+//! A power loss while logging can only cut the sector being written. Files on the card that
+//! are not the device's are left alone.
 
 use embedded_sdmmc::{BlockDevice, Mode, RawDirectory, RawFile, TimeSource, VolumeIdx, VolumeManager};
 
@@ -85,7 +86,9 @@ impl<D: BlockDevice, T: TimeSource> Card<D, T> {
             Err(e) => return Err(e.into()),
         };
         let file = self.volumes.open_file_in_dir(self.root, name, mode)?;
-        if let Err(e) = self.grow(file, size) {
+        // Its directory entry is written now, with the whole size: the FAT and the directory
+        // agree from here on, whenever the power goes.
+        if let Err(e) = self.grow(file, size).and_then(|()| Ok(self.volumes.flush_file(file)?)) {
             // What fit stays, a file a PC can delete; the device does not use it. A write
             // that ran out of clusters may have linked one more than the file's length
             // covers: it is filled, so that length and clusters agree again.
