@@ -157,3 +157,24 @@ fn a_full_card_refuses_the_file_that_does_not_fit_and_keeps_the_others() {
     assert_eq!(&copy_out(&path, "BIG.DAT")[..10], b"still here");
     assert!(fsck_clean(&path));
 }
+
+#[test]
+fn the_files_take_the_names_their_configuration_gives() {
+    let path = image("names");
+    let mut card = mount(&path);
+    for n in 0..8 {
+        let mut config = cr3101::logger::file_config::FileConfig::factory(n);
+        if n == 7 {
+            config.set_name(b"oil_temp").unwrap();
+        }
+        let mut name = [0_u8; 12];
+        let len = config.file_name(&mut name);
+        card.lay_out(n, std::str::from_utf8(&name[..len]).unwrap(), 512).unwrap();
+    }
+    let _ = card.unmount();
+    let listing = String::from_utf8(mtools("mdir", &path, &["-b", "::"]).stdout).unwrap();
+    for name in ["DATEI1.DAT", "DATEI7.DAT", "OIL_TEMP.DAT"] {
+        assert!(listing.contains(name), "{name} in {listing}");
+    }
+    assert!(fsck_clean(&path));
+}

@@ -1,6 +1,7 @@
 //! The cr3101 device, generated from `spec/cr3101.yaml`: its dictionary, default PDOs, node
 //! settings, serial codecs and app hooks. It runs as a plain CANopen node until its behaviour
-//! is written; [`card`] is the memory card that behaviour logs to.
+//! is written; [`card`] is the memory card that behaviour logs to, [`logger`] the model of its
+//! configuration.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(warnings)]
@@ -10,3 +11,4 @@
 coforge_macros::device!("../../../spec/cr3101.yaml");
 
 pub mod card;
+pub mod logger;
