@@ -5,7 +5,8 @@
 
 use coforge_sim::card::CardImage;
 use cr3101::card::files::{Card, CardError};
-use cr3101::card::record::{ComponentType, Record, RecordLayout, TimeStamp};
+use cr3101::card::record::Record;
+use cr3101::card::sample::{layout, record};
 use embedded_sdmmc::{TimeSource, Timestamp};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -56,24 +57,6 @@ fn fsck_clean(path: &Path) -> bool {
     std::fs::write(&part, &bytes[MIB as usize..]).unwrap();
     let out = Command::new("fsck.fat").arg("-n").arg(&part).output().expect("fsck.fat (cargo xtask test installs dosfstools)");
     out.status.success()
-}
-
-fn layout() -> RecordLayout {
-    let mut l = RecordLayout { relevant: 0b0000_1011, ..RecordLayout::default() };
-    l.types[0] = ComponentType::Word;
-    l.types[1] = ComponentType::Dint;
-    l.types[3] = ComponentType::Byte;
-    l
-}
-
-fn record(n: u32) -> Record {
-    let l = layout();
-    let mut r = Record::new(&l);
-    r.set(&l, 0, &(n as u16).to_le_bytes());
-    r.set(&l, 1, &(-(n as i32) * 1000).to_le_bytes());
-    r.set(&l, 3, &[(n % 251) as u8]);
-    r.stamp(&TimeStamp { millisecond: (n % 1000) as u16, second: (n % 60) as u8, minute: 30, hour: 6, day: 3, month: 12, year: 26 });
-    r
 }
 
 #[test]

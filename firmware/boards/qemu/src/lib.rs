@@ -9,6 +9,7 @@ pub mod bench;
 pub mod clock;
 pub mod host_file;
 pub mod line_console;
+pub mod mmio;
 pub mod sd;
 pub mod serve;
 pub mod uart;

@@ -9,6 +9,7 @@
 //! - it takes the data token of a block write only one byte after the command's R1; the layer
 //!   sends one FFh before the token.
 
+use crate::mmio::{read, write};
 use core::convert::Infallible;
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 
@@ -40,17 +41,6 @@ const CMD58: u8 = 0x40 | 58;
 /// Data tokens of single- and multiple-block writes.
 const DATA_START: u8 = 0xFE;
 const WRITE_MULTIPLE_START: u8 = 0xFC;
-
-fn read(address: usize) -> u32 {
-    // SAFETY: `address` is one of the SYSCTL, SSI0 or GPIO D registers above: aligned device
-    // registers of the lm3s6965, always mapped.
-    unsafe { core::ptr::read_volatile(address as *const u32) }
-}
-
-fn write(address: usize, value: u32) {
-    // SAFETY: as in `read`.
-    unsafe { core::ptr::write_volatile(address as *mut u32, value) }
-}
 
 /// Where the card is in the exchange of the command last sent (for the quirks).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,6 +1,8 @@
 //! The lm3s6965's PL011-style UARTs, polled: a byte in when one is waiting, a byte out when
 //! the FIFO has room.
 
+use crate::mmio;
+
 /// UART0 (the first `-serial` of QEMU).
 pub const UART0: usize = 0x4000_C000;
 /// UART1 (the second `-serial`).
@@ -46,14 +48,11 @@ impl Uart {
     }
 
     fn read_reg(&self, offset: usize) -> u32 {
-        // SAFETY: `base` is one of the three UART blocks above and `offset` one of the register
-        // offsets of its data sheet: an aligned, always-mapped device register.
-        unsafe { core::ptr::read_volatile((self.base + offset) as *const u32) }
+        mmio::read(self.base + offset)
     }
 
     fn write_reg(&self, offset: usize, value: u32) {
-        // SAFETY: as in `read_reg`.
-        unsafe { core::ptr::write_volatile((self.base + offset) as *mut u32, value) }
+        mmio::write(self.base + offset, value)
     }
 
     /// A received byte, if one is waiting.

@@ -275,12 +275,22 @@ impl EntryInfo {
         index >= self.index && index - self.index <= u16::from(self.copies())
     }
 
+    /// Strings and domains: a value shorter than `size` is whole.
+    pub const fn is_variable_length(&self) -> bool {
+        matches!(self.data_type(), DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain)
+    }
+
+    /// Whether a value of `len` bytes has this entry's length: its size, or up to it for
+    /// strings and domains (what an SDO write, a PDO mapping and a loaded file must give).
+    pub fn takes_len(&self, len: usize) -> bool {
+        self.check_length(len).is_ok()
+    }
+
     fn check_length(&self, len: usize) -> Result<(), SdoAbort> {
         let size = usize::from(self.size);
-        let variable = matches!(self.data_type(), DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
         if len > size {
             Err(SdoAbort::LengthTooHigh)
-        } else if len < size && !variable {
+        } else if len < size && !self.is_variable_length() {
             Err(SdoAbort::LengthTooLow)
         } else {
             Ok(())

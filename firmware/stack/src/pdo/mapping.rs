@@ -2,7 +2,7 @@
 //! mapped values into a frame.
 
 use super::Dir;
-use crate::od::{DataType, EntryAccess, EntryInfo, SdoAbort, find_run};
+use crate::od::{EntryAccess, EntryInfo, SdoAbort, find_run};
 
 /// Most entries a PDO maps (one per byte of a CAN frame).
 pub const MAX_MAPPED: usize = 8;
@@ -91,8 +91,7 @@ pub fn check_entry(od: &impl EntryAccess, word: u32, dir: Dir) -> Result<Mapped,
     if !e.pdo_mappable() || !allowed {
         return Err(SdoAbort::NotMappable);
     }
-    let variable = matches!(e.data_type(), DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
-    let fits = if variable { u16::from(bytes) <= e.size } else { u16::from(bytes) == e.size };
+    let fits = e.takes_len(usize::from(bytes));
     let run = u16::try_from(run).map_err(|_| SdoAbort::NotMappable)?;
     // `find_run` only returns a run that covers `index`, so the copy is at most `e.copies()`.
     let copy = u8::try_from(index - e.index).map_err(|_| SdoAbort::NotMappable)?;

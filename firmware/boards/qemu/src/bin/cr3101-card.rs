@@ -10,7 +10,8 @@ use coforge_board_qemu::sd::{SdSpi, SpinDelay};
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use cr3101::card::files::Card;
-use cr3101::card::record::{ComponentType, Record, RecordLayout, TimeStamp};
+use cr3101::card::record::Record;
+use cr3101::card::sample::{layout, record};
 use embedded_sdmmc::{SdCard, TimeSource, Timestamp};
 use panic_semihosting as _;
 
@@ -21,25 +22,6 @@ impl TimeSource for Clock {
     fn get_timestamp(&self) -> Timestamp {
         Timestamp { year_since_1970: 56, zero_indexed_month: 11, zero_indexed_day: 2, hours: 6, minutes: 30, seconds: 0 }
     }
-}
-
-/// The records' layout: component 1 WORD, component 2 DINT, component 4 BYTE (16 bytes).
-fn layout() -> RecordLayout {
-    let mut l = RecordLayout { relevant: 0b0000_1011, ..RecordLayout::default() };
-    l.types[1] = ComponentType::Dint;
-    l.types[3] = ComponentType::Byte;
-    l
-}
-
-/// Record `n`: the same values the test computes.
-fn record(n: u32) -> Record {
-    let l = layout();
-    let mut r = Record::new(&l);
-    r.set(&l, 0, &(n as u16).to_le_bytes());
-    r.set(&l, 1, &(-(n as i32) * 1000).to_le_bytes());
-    r.set(&l, 3, &[(n % 251) as u8]);
-    r.stamp(&TimeStamp { millisecond: (n % 1000) as u16, second: (n % 60) as u8, minute: 30, hour: 6, day: 3, month: 12, year: 26 });
-    r
 }
 
 fn fail(what: &str) -> ! {

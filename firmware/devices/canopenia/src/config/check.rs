@@ -14,15 +14,11 @@
 
 use coforge_beds::layout::func;
 use coforge_beds::{BinaryEds, OdEntry, PdoRecord, Table};
-use coforge_stack::od::{DataType, EntryInfo, SdoAbort, find};
+use coforge_stack::od::{EntryInfo, SdoAbort, find};
+use coforge_stack::pdo::Dir;
 
 /// The bit rates of CiA 301's bit timing table, in kbit/s.
 const BIT_RATES: [u16; 9] = [10, 20, 50, 100, 125, 250, 500, 800, 1000];
-/// Communication parameter indices of PDO 1.
-const RPDO_COMM: u16 = 0x1400;
-const TPDO_COMM: u16 = 0x1800;
-/// Mapping parameters are 200h above their communication parameters.
-const MAPPING: u16 = 0x200;
 
 /// Checks `file` against the dictionary `entries`.
 pub fn check(file: &BinaryEds<'_>, entries: &[EntryInfo]) -> Result<(), SdoAbort> {
@@ -36,9 +32,9 @@ pub fn check(file: &BinaryEds<'_>, entries: &[EntryInfo]) -> Result<(), SdoAbort
     for e in file.generic_entries() {
         check_entry(entries, e.index, e.sub, e.size)?;
     }
-    for (table, comm) in [(Table::Rpdos, RPDO_COMM), (Table::Tpdos, TPDO_COMM)] {
+    for (table, dir) in PDO_TABLES {
         for pdo in file.pdos(table) {
-            check_pdo(file, entries, &pdo, comm)?;
+            check_pdo(file, entries, &pdo, dir)?;
         }
     }
     Ok(())
@@ -59,16 +55,14 @@ fn check_settings(file: &BinaryEds<'_>) -> Result<(), SdoAbort> {
 /// decides it, so a file may list fewer sub-entries, not more.
 fn check_entry(entries: &[EntryInfo], index: u16, sub: u8, size: u16) -> Result<(), SdoAbort> {
     let info = find(entries, index, sub)?;
-    let variable = matches!(info.data_type(), DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain);
-    let fits = if variable { size <= info.size } else { size == info.size };
-    if fits { Ok(()) } else { Err(SdoAbort::LengthMismatch) }
+    if info.takes_len(usize::from(size)) { Ok(()) } else { Err(SdoAbort::LengthMismatch) }
 }
 
 /// The dictionary must have the PDO's parameters, and its entries must be mappable.
-fn check_pdo(file: &BinaryEds<'_>, entries: &[EntryInfo], pdo: &PdoRecord, comm: u16) -> Result<(), SdoAbort> {
-    let comm = pdo.number.checked_sub(1).map(|n| comm + u16::from(n)).ok_or(SdoAbort::NoObject)?;
+fn check_pdo(file: &BinaryEds<'_>, entries: &[EntryInfo], pdo: &PdoRecord, dir: Dir) -> Result<(), SdoAbort> {
+    let comm = pdo.number.checked_sub(1).map(|n| dir.comm_base() + u16::from(n)).ok_or(SdoAbort::NoObject)?;
     find(entries, comm, 1)?;
-    find(entries, comm + MAPPING, 0)?;
+    find(entries, Dir::mapping_of(comm), 0)?;
     let mut bytes = 0_u16;
     for e in mapped(file, pdo) {
         let info = find(entries, e.index, e.sub)?;
@@ -82,6 +76,9 @@ fn check_pdo(file: &BinaryEds<'_>, entries: &[EntryInfo], pdo: &PdoRecord, comm:
     }
     Ok(())
 }
+
+/// A file's PDO tables and the direction of each.
+pub const PDO_TABLES: [(Table, Dir); 2] = [(Table::Rpdos, Dir::Rx), (Table::Tpdos, Dir::Tx)];
 
 /// Entries the vendor's tool lists at process-image offset 0 with no room of their own: the
 /// firmware serves them, the file holds no value for them (erratum COIA-39).

@@ -5,3 +5,5 @@
 
 pub mod files;
 pub mod record;
+#[cfg(feature = "card-sample")]
+pub mod sample;
