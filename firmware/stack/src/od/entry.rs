@@ -282,8 +282,9 @@ impl EntryInfo {
 
     /// Whether a value of `len` bytes has this entry's length: its size, or up to it for
     /// strings and domains (what an SDO write, a PDO mapping and a loaded file must give).
-    pub fn takes_len(&self, len: usize) -> bool {
-        self.check_length(len).is_ok()
+    pub const fn takes_len(&self, len: usize) -> bool {
+        let size = self.size as usize;
+        len == size || (len < size && self.is_variable_length())
     }
 
     fn check_length(&self, len: usize) -> Result<(), SdoAbort> {
