@@ -68,8 +68,17 @@ pub fn mapping_length(d: &Device, diags: &mut Diagnostics) {
             None if is_dummy(m) => crate::types::DataType::ALL.iter().find(|t| t.code() == m.index).and_then(|t| t.bits()),
             None => None,
         };
-        if let Some(bits) = want.filter(|&b| b != u32::from(m.bits)) {
-            diags.push(Diagnostic::error("pdo-mapping-length", m.span, format!("{} with {} bits, but the entry is {bits} bits", mapped(pdo, m), m.bits)));
+        // A string or domain maps any whole number of bytes up to its length (the stack's
+        // `EntryInfo::takes_len`): CR3101's components take their configured type's size.
+        let variable = entry.is_some_and(|e| e.data_type.bits().is_none());
+        let fits = |bits: u32| if variable { m.bits % 8 == 0 && m.bits > 0 && u32::from(m.bits) <= bits } else { u32::from(m.bits) == bits };
+        if let Some(bits) = want.filter(|&b| !fits(b)) {
+            let up_to = if variable { "up to " } else { "" };
+            diags.push(Diagnostic::error(
+                "pdo-mapping-length",
+                m.span,
+                format!("{} with {} bits, but the entry takes {up_to}{bits} bits", mapped(pdo, m), m.bits),
+            ));
         }
     });
 }

@@ -11,4 +11,5 @@
 coforge_macros::device!("../../../spec/cr3101.yaml");
 
 pub mod card;
+pub mod clock;
 pub mod logger;

@@ -12,6 +12,10 @@ use embedded_sdmmc::{BlockDevice, Mode, RawDirectory, RawFile, TimeSource, Volum
 
 /// Data files (3000h..3700h).
 pub const FILES: usize = 8;
+/// Files the device keeps open: the data files, then the configuration file.
+pub const SLOTS: usize = FILES + 1;
+/// The configuration file's slot ([`super::settings`]).
+pub const SETTINGS_SLOT: usize = FILES;
 /// Bytes written at a time to pre-allocate a file.
 const FILL: usize = 512;
 
@@ -45,9 +49,9 @@ impl<E: core::error::Error> From<embedded_sdmmc::Error<E>> for CardError {
 
 /// The mounted card.
 pub struct Card<D: BlockDevice, T: TimeSource> {
-    volumes: VolumeManager<D, T, 1, FILES, 1>,
+    volumes: VolumeManager<D, T, 1, SLOTS, 1>,
     root: RawDirectory,
-    files: [Option<(RawFile, u32)>; FILES],
+    files: [Option<(RawFile, u32)>; SLOTS],
 }
 
 impl<D: BlockDevice, T: TimeSource> core::fmt::Debug for Card<D, T> {
@@ -62,10 +66,16 @@ impl<D: BlockDevice, T: TimeSource> Card<D, T> {
         let volumes = VolumeManager::new_with_limits(device, time, 0);
         let volume = volumes.open_raw_volume(VolumeIdx(0))?;
         let root = volumes.open_root_dir(volume)?;
-        Ok(Card { volumes, root, files: [None; FILES] })
+        Ok(Card { volumes, root, files: [None; SLOTS] })
     }
 
-    /// File `n` (0-based) named `name` (8.3, such as `OIL_TEMP.DAT`) with `size` bytes: made
+    /// The card's size in bytes.
+    pub fn capacity(&self) -> Result<u64, CardError> {
+        let blocks = self.volumes.device(|d| d.num_blocks()).map_err(|_| CardError::Device)?;
+        Ok(u64::from(blocks.0) * 512)
+    }
+
+    /// File `n` (0-based; [`SETTINGS_SLOT`] the configuration file) named `name` (8.3, such as `OIL_TEMP.DAT`) with `size` bytes: made
     /// if the card lacks it, grown with zeros if shorter, cut to nothing and grown again if
     /// longer, and kept open. Size 0: the file is not used, and stays on the card as it is.
     /// Files are never deleted: embedded-sdmmc 0.10 leaves a deleted file's clusters
@@ -163,7 +173,7 @@ impl<D: BlockDevice, T: TimeSource> Card<D, T> {
 
     /// Closes every file (their directory entries written) and gives the device back.
     pub fn unmount(mut self) -> D {
-        for n in 0..FILES {
+        for n in 0..SLOTS {
             let _ = self.close(n);
         }
         let _ = self.volumes.close_dir(self.root);

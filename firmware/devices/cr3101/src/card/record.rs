@@ -41,6 +41,18 @@ impl ComponentType {
         })
     }
 
+    /// The DEFTYPE index (3x1ch.2).
+    pub const fn code(self) -> u16 {
+        match self {
+            ComponentType::Int => 3,
+            ComponentType::Dint => 4,
+            ComponentType::Byte => 5,
+            ComponentType::Word => 6,
+            ComponentType::Dword => 7,
+            ComponentType::Real => 8,
+        }
+    }
+
     /// Bytes on the card, over SDO and in a PDO.
     pub const fn size(self) -> usize {
         match self {
@@ -216,5 +228,6 @@ mod tests {
         let sizes: [Option<usize>; 7] = core::array::from_fn(|i| ComponentType::of_code(i as u16 + 2).map(ComponentType::size));
         assert_eq!(sizes, [None, Some(2), Some(4), Some(1), Some(2), Some(4), Some(4)]);
         assert_eq!(ComponentType::of_code(9), None);
+        (3..=8).for_each(|code| assert_eq!(ComponentType::of_code(code).map(ComponentType::code), Some(code)));
     }
 }

@@ -56,6 +56,12 @@ pub struct Text<const N: usize> {
     len: usize,
 }
 
+impl<const N: usize> Default for Text<N> {
+    fn default() -> Self {
+        Text { bytes: [0; N], len: 0 }
+    }
+}
+
 impl<const N: usize> Text<N> {
     /// `value` without trailing blanks and NULs; `None` if longer than `N`.
     pub fn new(value: &[u8]) -> Option<Self> {
@@ -240,6 +246,88 @@ impl FileConfig {
     }
 }
 
+/// Bytes of one file's configuration in the card's configuration file:
+///
+/// | bytes | content |
+/// |---|---|
+/// | 0..8, 8..11 | 3x00h.1 name, 3x00h.2 extension (NUL-padded) |
+/// | 11..13 | 3x01h relevant components |
+/// | 13, 14 | 3x03h.1 mode, 3x03h.2 ring (55h) or linear (00h) |
+/// | 15..19 | 3x03h.3 interval |
+/// | 19..23, 23..27, 27..31 | 3x04h, 3x05h, 3x06h |
+/// | 31..111 | per component: 3x1ch.1 name (8, NUL-padded), 3x1ch.2 type (2) |
+///
+/// Numbers little-endian.
+pub const ENCODED_LEN: usize = 31 + COMPONENTS * 10;
+
+fn put<const N: usize>(out: &mut [u8], at: usize, bytes: [u8; N]) {
+    if let Some(dst) = out.get_mut(at..at + N) {
+        dst.copy_from_slice(&bytes);
+    }
+}
+
+fn take<const N: usize>(bytes: &[u8], at: usize) -> [u8; N] {
+    let mut b = [0; N];
+    if let Some(src) = bytes.get(at..at + N) {
+        b.copy_from_slice(src);
+    }
+    b
+}
+
+impl<const N: usize> Text<N> {
+    fn padded(&self) -> [u8; N] {
+        self.bytes
+    }
+}
+
+impl FileConfig {
+    /// The configuration as the card's configuration file holds it.
+    pub fn encode(&self) -> [u8; ENCODED_LEN] {
+        let mut out = [0; ENCODED_LEN];
+        put(&mut out, 0, self.name.padded());
+        put(&mut out, 8, self.extension.padded());
+        put(&mut out, 11, self.relevant.to_le_bytes());
+        put(&mut out, 13, [self.mode.code(), if self.ring { RING } else { 0 }]);
+        put(&mut out, 15, self.interval.to_le_bytes());
+        put(&mut out, 19, self.current.to_le_bytes());
+        put(&mut out, 23, self.write_pointer.to_le_bytes());
+        put(&mut out, 27, self.count.to_le_bytes());
+        for (c, component) in self.components.iter().enumerate() {
+            put(&mut out, 31 + c * 10, component.name.padded());
+            put(&mut out, 39 + c * 10, component.ty.code().to_le_bytes());
+        }
+        out
+    }
+
+    /// A configuration from the card's configuration file; `None` if any field breaks a
+    /// rule a write would have to keep.
+    pub fn decode(bytes: &[u8; ENCODED_LEN]) -> Option<FileConfig> {
+        let mut f = FileConfig::factory(0);
+        f.set_name(&take::<8>(bytes, 0)).ok()?;
+        f.set_extension(&take::<3>(bytes, 8)).ok()?;
+        f.relevant = u16::from_le_bytes(take(bytes, 11));
+        let [mode, ring] = take::<2>(bytes, 13);
+        f.mode = Mode::of_code(mode)?;
+        f.ring = match ring {
+            RING => true,
+            0 => false,
+            _ => return None,
+        };
+        f.interval = u32::from_le_bytes(take(bytes, 15));
+        if f.interval == 0 && f.mode != Mode::Autoincrement {
+            return None;
+        }
+        f.current = u32::from_le_bytes(take(bytes, 19));
+        f.write_pointer = u32::from_le_bytes(take(bytes, 23));
+        f.count = u32::from_le_bytes(take(bytes, 27));
+        for (c, component) in f.components.iter_mut().enumerate() {
+            component.name = Text::new(&take::<8>(bytes, 31 + c * 10))?;
+            component.ty = ComponentType::of_code(u16::from_le_bytes(take(bytes, 39 + c * 10)))?;
+        }
+        Some(f)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -297,5 +385,29 @@ mod tests {
         assert_eq!(f.set_current(10, 150), Err(SdoAbort::ValueTooHigh));
         assert_eq!(f.set_write_pointer(10, 150), Err(SdoAbort::ValueTooHigh));
         assert_eq!((f.current(), f.write_pointer()), (9, 0));
+    }
+
+    #[test]
+    fn a_configuration_round_trips_through_its_encoding_and_bad_fields_are_refused() {
+        let mut f = FileConfig::factory(4);
+        f.set_name(b"OIL_TEMP").unwrap();
+        f.relevant = 0x00A5;
+        f.set_mode(0x03).unwrap();
+        f.set_interval(0).unwrap();
+        f.ring = true;
+        f.components[6] = Component { name: Text::new(b"Pressure").unwrap(), ty: ComponentType::Real };
+        f.set_current(3, 1000).unwrap();
+        let bytes = f.encode();
+        assert_eq!(FileConfig::decode(&bytes), Some(f));
+        let mut bad = bytes;
+        bad[13] = 0x04;
+        assert_eq!(FileConfig::decode(&bad), None, "no mode 04h");
+        let mut bad = bytes;
+        bad[39] = 9;
+        assert_eq!(FileConfig::decode(&bad), None, "no type 0009h");
+        let mut bad = bytes;
+        bad[0] = b' ';
+        bad[1] = b'.';
+        assert_eq!(FileConfig::decode(&bad), None, "not an 8.3 name");
     }
 }
