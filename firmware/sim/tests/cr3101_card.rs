@@ -70,8 +70,8 @@ fn records_written_in_place_read_back_with_mtools_and_the_card_stays_clean() {
     mtools("mcopy", &path, &[foreign.to_str().unwrap(), "::NOTES.TXT"]);
 
     let mut card = mount(&path);
-    card.lay_out(0, "OIL_TEMP.DAT", (len * 100) as u32).unwrap();
-    card.lay_out(2, "PRESS.DAT", 4096).unwrap();
+    card.lay_out(0, "OIL_TEMP.DAT", (len * 100) as u32, false).unwrap();
+    card.lay_out(2, "PRESS.DAT", 4096, false).unwrap();
     let mut expected = vec![0_u8; len * 100];
     for n in 0..100_u32 {
         let r = record(n);
@@ -100,26 +100,26 @@ fn records_written_in_place_read_back_with_mtools_and_the_card_stays_clean() {
 fn laying_out_again_keeps_a_file_of_the_same_size_and_remakes_a_smaller_one() {
     let path = image("relayout");
     let mut card = mount(&path);
-    card.lay_out(0, "A.DAT", 3000).unwrap();
+    card.lay_out(0, "A.DAT", 3000, false).unwrap();
     card.write_at(0, 2990, b"0123456789").unwrap();
     let _ = card.unmount();
 
     let mut card = mount(&path);
-    card.lay_out(0, "A.DAT", 3000).unwrap();
+    card.lay_out(0, "A.DAT", 3000, false).unwrap();
     let mut tail = [0_u8; 10];
     card.read_at(0, 2990, &mut tail).unwrap();
     assert_eq!(&tail, b"0123456789", "the same size: kept as it is");
-    card.lay_out(0, "A.DAT", 5000).unwrap();
+    card.lay_out(0, "A.DAT", 5000, false).unwrap();
     card.read_at(0, 2990, &mut tail).unwrap();
     assert_eq!(&tail, b"0123456789", "grown: kept, zeros after it");
-    card.lay_out(0, "A.DAT", 1000).unwrap();
+    card.lay_out(0, "A.DAT", 1000, false).unwrap();
     assert_eq!(card.size(0), Some(1000));
     let mut head = [0_u8; 10];
     card.read_at(0, 0, &mut head).unwrap();
     assert_eq!(head, [0; 10], "made again: zeros");
-    card.lay_out(0, "A.DAT", 0).unwrap();
+    card.lay_out(0, "A.DAT", 0, false).unwrap();
     assert_eq!(card.size(0), None);
-    assert_eq!(card.lay_out(1, "BAD NAME.DATA", 10), Err(CardError::Name));
+    assert_eq!(card.lay_out(1, "BAD NAME.DATA", 10, false), Err(CardError::Name));
     let _ = card.unmount();
     assert_eq!(copy_out(&path, "A.DAT").len(), 1000, "size 0: not used, left as it was");
     assert!(fsck_clean(&path));
@@ -129,8 +129,8 @@ fn laying_out_again_keeps_a_file_of_the_same_size_and_remakes_a_smaller_one() {
 fn a_full_card_refuses_the_file_that_does_not_fit_and_keeps_the_others() {
     let path = image("full");
     let mut card = mount(&path);
-    card.lay_out(0, "BIG.DAT", 10 * MIB as u32).unwrap();
-    assert_eq!(card.lay_out(1, "HUGE.DAT", 8 * MIB as u32), Err(CardError::Full));
+    card.lay_out(0, "BIG.DAT", 10 * MIB as u32, false).unwrap();
+    assert_eq!(card.lay_out(1, "HUGE.DAT", 8 * MIB as u32, false), Err(CardError::Full));
     assert_eq!(card.size(1), None);
     card.write_at(0, 0, b"still here").unwrap();
     let _ = card.unmount();
@@ -152,7 +152,7 @@ fn the_files_take_the_names_their_configuration_gives() {
         }
         let mut name = [0_u8; 12];
         let len = config.file_name(&mut name);
-        card.lay_out(n, std::str::from_utf8(&name[..len]).unwrap(), 512).unwrap();
+        card.lay_out(n, std::str::from_utf8(&name[..len]).unwrap(), 512, false).unwrap();
     }
     let _ = card.unmount();
     let listing = String::from_utf8(mtools("mdir", &path, &["-b", "::"]).stdout).unwrap();

@@ -1,7 +1,13 @@
-//! The cr3101 device, generated from `spec/cr3101.yaml`: its dictionary, default PDOs, node
-//! settings, serial codecs and app hooks. It runs as a plain CANopen node until its behaviour
-//! is written; [`card`] is the memory card that behaviour logs to, [`logger`] the model of its
-//! configuration.
+//! The CR3101 CANmem data logger (`spec/cr3101.yaml`): process data from RPDOs logged as
+//! time-stamped records into up to eight files on a FAT memory card, read back over SDO or
+//! the PDO read mode.
+//!
+//! - [`board`]: what a board provides: the card slot, the clock at power-on, the LEDs;
+//! - [`card`]: what lands on the card and how (records, files, the configuration file);
+//! - [`clock`]: the real-time clock (2010h);
+//! - [`logger`]: the files' configurations and operating modes over the card;
+//! - `objects`: the app-backed objects' hooks, handed to the logger;
+//! - [`device`]: the whole device, driven by CAN frames and time.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(warnings)]
@@ -10,6 +16,12 @@
 
 coforge_macros::device!("../../../spec/cr3101.yaml");
 
+pub mod board;
 pub mod card;
 pub mod clock;
+pub mod device;
 pub mod logger;
+mod objects;
+
+pub use board::{Board, CardSense, StatusLeds};
+pub use device::Cr3101;

@@ -37,7 +37,7 @@ fn main() -> ! {
     let sd = SdCard::new(SdSpi::new(), SpinDelay);
     let Ok(mut card) = Card::mount(sd, Clock) else { fail("mount") };
     let len = layout().len() as u32;
-    if card.lay_out(0, "OIL_TEMP.DAT", 200 * len).is_err() || card.lay_out(2, "PRESS.DAT", 4096).is_err() {
+    if card.lay_out(0, "OIL_TEMP.DAT", 200 * len, false).is_err() || card.lay_out(2, "PRESS.DAT", 4096, false).is_err() {
         fail("lay out");
     }
     hprintln!("cr3101-card: laid out");

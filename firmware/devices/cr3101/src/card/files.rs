@@ -61,12 +61,15 @@ impl<D: BlockDevice, T: TimeSource> core::fmt::Debug for Card<D, T> {
 }
 
 impl<D: BlockDevice, T: TimeSource> Card<D, T> {
-    /// Mounts the FAT volume of the card's first partition.
-    pub fn mount(device: D, time: T) -> Result<Self, CardError> {
+    /// Mounts the FAT volume of the card's first partition; a card that has none is handed
+    /// back with the reason.
+    pub fn mount(device: D, time: T) -> Result<Self, (CardError, D)> {
         let volumes = VolumeManager::new_with_limits(device, time, 0);
-        let volume = volumes.open_raw_volume(VolumeIdx(0))?;
-        let root = volumes.open_root_dir(volume)?;
-        Ok(Card { volumes, root, files: [None; SLOTS] })
+        let root = volumes.open_raw_volume(VolumeIdx(0)).and_then(|volume| volumes.open_root_dir(volume));
+        match root {
+            Ok(root) => Ok(Card { volumes, root, files: [None; SLOTS] }),
+            Err(e) => Err((e.into(), volumes.free().0)),
+        }
     }
 
     /// The card's size in bytes.
@@ -80,7 +83,10 @@ impl<D: BlockDevice, T: TimeSource> Card<D, T> {
     /// longer, and kept open. Size 0: the file is not used, and stays on the card as it is.
     /// Files are never deleted: embedded-sdmmc 0.10 leaves a deleted file's clusters
     /// allocated, and a file emptied by truncation keeps one, which `fsck.fat` reports.
-    pub fn lay_out(&mut self, n: usize, name: &str, size: u32) -> Result<(), CardError> {
+    ///
+    /// With `erase`, what the file keeps of its old contents is overwritten with zeros too
+    /// (in place: the FAT does not change).
+    pub fn lay_out(&mut self, n: usize, name: &str, size: u32, erase: bool) -> Result<(), CardError> {
         self.close(n)?;
         let slot = self.files.get(n).ok_or(CardError::Range)?;
         debug_assert!(slot.is_none());
@@ -96,9 +102,11 @@ impl<D: BlockDevice, T: TimeSource> Card<D, T> {
             Err(e) => return Err(e.into()),
         };
         let file = self.volumes.open_file_in_dir(self.root, name, mode)?;
+        let kept = if erase { self.volumes.file_length(file)? } else { 0 };
         // Its directory entry is written now, with the whole size: the FAT and the directory
         // agree from here on, whenever the power goes.
-        if let Err(e) = self.grow(file, size).and_then(|()| Ok(self.volumes.flush_file(file)?)) {
+        let laid_out = self.grow(file, size).and_then(|()| self.zero(file, kept)).and_then(|()| Ok(self.volumes.flush_file(file)?));
+        if let Err(e) = laid_out {
             // What fit stays, a file a PC can delete; the device does not use it. A write
             // that ran out of clusters may have linked one more than the file's length
             // covers: it is filled, so that length and clusters agree again.
@@ -125,6 +133,33 @@ impl<D: BlockDevice, T: TimeSource> Card<D, T> {
             len += n;
         }
         Ok(())
+    }
+
+    /// Overwrites the first `len` bytes of `file` with zeros.
+    fn zero(&mut self, file: RawFile, len: u32) -> Result<(), CardError> {
+        let zeros = [0_u8; FILL];
+        self.volumes.file_seek_from_start(file, 0)?;
+        let mut at = 0;
+        while at < len {
+            let n = (len - at).min(FILL as u32);
+            self.volumes.write(file, zeros.get(..n as usize).unwrap_or(&zeros))?;
+            at += n;
+        }
+        Ok(())
+    }
+
+    /// Opens file `n` named `name` as it is, for reading only (a write-protected card); its
+    /// size.
+    pub fn open_read_only(&mut self, n: usize, name: &str) -> Result<u32, CardError> {
+        self.close(n)?;
+        let slot = self.files.get(n).ok_or(CardError::Range)?;
+        debug_assert!(slot.is_none());
+        let file = self.volumes.open_file_in_dir(self.root, name, Mode::ReadOnly)?;
+        let size = self.volumes.file_length(file)?;
+        if let Some(slot) = self.files.get_mut(n) {
+            *slot = Some((file, size));
+        }
+        Ok(size)
     }
 
     /// Closes file `n` (its directory entry is written now).

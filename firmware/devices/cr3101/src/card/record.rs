@@ -179,6 +179,13 @@ impl Record {
         self.bytes.get(TIME_STAMP).copied().unwrap_or(0)
     }
 
+    /// A new record's modification status: nothing written into it yet.
+    pub fn clear_modified(&mut self) {
+        if let Some(m) = self.bytes.get_mut(TIME_STAMP) {
+            *m = 0;
+        }
+    }
+
     /// Writes component `c` (0-based; `value` at its type's size): `false` if it is not
     /// relevant or the value's length is not its type's.
     pub fn set(&mut self, layout: &RecordLayout, c: usize, value: &[u8]) -> bool {

@@ -236,13 +236,32 @@ impl FileConfig {
         Ok(())
     }
 
-    /// 3x06h: only 55h, which resets the count of records written.
+    /// 3x06h: only 55h, which resets the file: the count of records written and the write
+    /// pointer go back to 0 (erratum CR-24).
     pub fn reset_count(&mut self, value: u32) -> Result<(), SdoAbort> {
         if value != RESET_COUNT {
             return Err(SdoAbort::InvalidValue);
         }
         self.count = 0;
+        self.write_pointer = 0;
         Ok(())
+    }
+
+    /// Every pointer at record 0 (a file laid out afresh).
+    pub fn reset_pointers(&mut self) {
+        (self.current, self.write_pointer, self.count) = (0, 0, 0);
+    }
+
+    /// Logging moved on: the next record goes to `write_pointer`, `count` have been written.
+    pub fn set_progress(&mut self, write_pointer: u32, count: u32) {
+        (self.write_pointer, self.count) = (write_pointer, count);
+    }
+
+    /// Autoincrement writing reached the end of a linear file: the file goes over to direct
+    /// reading, showing its last record, `last`.
+    pub fn switch_to_reading(&mut self, last: u32) {
+        self.mode = Mode::DirectReading;
+        self.current = last;
     }
 }
 
@@ -370,8 +389,9 @@ mod tests {
         f.set_mode(0x10).unwrap();
         assert_eq!(f.set_mode(0x04), Err(SdoAbort::InvalidValue));
         assert_eq!(f.reset_count(0), Err(SdoAbort::InvalidValue));
+        f.set_progress(7, 9);
         f.reset_count(0x55).unwrap();
-        assert_eq!(f.count(), 0);
+        assert_eq!((f.count(), f.write_pointer()), (0, 0));
     }
 
     #[test]
