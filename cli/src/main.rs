@@ -114,6 +114,9 @@ enum Cmd {
     /// EEPROM byte, offsets as in the bank layout of coforge-storage) and `outputs`. CO401GW1
     /// takes `in <bits>` (bit n: input INn active), `emy0 on|off`, `emy1 on|off`, `enable
     /// [alt]` (what the host's 02 00 / 02 81 does) and `pins` (outputs, LEDs, watchdog).
+    /// CR3101 takes `card remove`, `card insert [protected]`, `battery low|ok` and `leds`; its
+    /// node-ID and mode come from 20F0h/20F1h and 20F5h at power-on, `--node-id` being the
+    /// pair's factory setting and `--mode` overriding 20F5h.
     Sim {
         /// Device crate name: co401memory1, co401gw1, cr3101 or canopenia.
         device: String,
@@ -132,6 +135,11 @@ enum Cmd {
         /// FILE.configuration).
         #[arg(long)]
         store: Option<PathBuf>,
+        /// CR3101: the memory card in the slot is this image file (made and formatted, 64 MiB,
+        /// if there is none; `coforge card` makes one of another size). Without it the slot
+        /// holds a new card in memory. A PC reads the image with `mdir -i FILE@@1M ::`.
+        #[arg(long)]
+        card: Option<PathBuf>,
         /// Serve the first node's serial host interface on this TCP port (0 picks a free
         /// one; the address is printed). pyserial: `serial_for_url('socket://127.0.0.1:PORT')`.
         #[arg(long)]
@@ -241,6 +249,7 @@ struct SimArgs<'a> {
     port: u16,
     mode: Option<&'a str>,
     store: Option<PathBuf>,
+    card: Option<PathBuf>,
     count: u8,
     connect: &'a [String],
     seconds: Option<u64>,
@@ -249,7 +258,7 @@ struct SimArgs<'a> {
 }
 
 fn sim(args: SimArgs<'_>) -> Result<ExitCode, String> {
-    let SimArgs { device, first_id, port, mode, store, count, connect, seconds, serial, enable_can } = args;
+    let SimArgs { device, first_id, port, mode, store, card, count, connect, seconds, serial, enable_can } = args;
     use coforge_sim::devices::{DeviceKind, StoreAt};
     let kind = DeviceKind::find(device)?;
     if count == 0 || u16::from(first_id) + u16::from(count) - 1 > 127 {
@@ -258,8 +267,16 @@ fn sim(args: SimArgs<'_>) -> Result<ExitCode, String> {
     if count > 1 && store.is_some() {
         return Err("--store keeps one node's parameters; use it with --nodes 1".into());
     }
+    if count > 1 && card.is_some() {
+        return Err("--card is one node's card; use it with --nodes 1".into());
+    }
     let at = store.map_or(StoreAt::Memory, StoreAt::File);
-    let mut nodes = (first_id..first_id + count).map(|id| kind.create(mode, id, &at)).collect::<Result<Vec<_>, _>>()?;
+    let mut nodes = (first_id..first_id + count)
+        .map(|id| match &card {
+            Some(card) => kind.create_with_card(mode, id, &at, card),
+            None => kind.create(mode, id, &at),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let hub = coforge_sim::hub::Hub::bind(("127.0.0.1", port)).map_err(|e| format!("cannot listen on port {port}: {e}"))?;
     connect_all(&hub, connect)?;
     let has_serial = nodes.first_mut().is_some_and(|n| n.host_port().is_some());
@@ -379,12 +396,13 @@ fn run(cmd: Cmd) -> Result<ExitCode, String> {
             })
             .map_err(|e| format!("{}: {e}", file.display())),
         Cmd::Master { port, timeout_ms, cmd } => master::run(&port, timeout_ms, cmd),
-        Cmd::Sim { device, node_id, port, mode, store, nodes, connect, seconds, serial, enable_can } => sim(SimArgs {
+        Cmd::Sim { device, node_id, port, mode, store, card, nodes, connect, seconds, serial, enable_can } => sim(SimArgs {
             device: &device,
             first_id: node_id,
             port,
             mode: mode.as_deref(),
             store,
+            card,
             count: nodes,
             connect: &connect,
             seconds,

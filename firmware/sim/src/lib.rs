@@ -6,6 +6,8 @@
 //! - [`devices`]: the coforge devices by name, built and driven through the device contract;
 //! - [`memory1`]: CO401Memory1's console commands (supply, corrupt, outputs);
 //! - [`gw1`]: CO401GW1's console commands (input and emergency pins, enable, pins);
+//! - [`cr3101`]: CR3101's board (a card image in its slot) and console (card, battery, LEDs);
+//! - [`card`]: card images as a PC formats them;
 //! - [`runner`]: real-time nodes on a hub, one thread for all of them;
 //! - [`serial`]: a device's serial host interface on a TCP port;
 //! - [`vbus`]: a deterministic in-process bus on a virtual clock, for tests;
@@ -17,6 +19,7 @@
 pub mod app;
 pub mod canopenia;
 pub mod card;
+pub mod cr3101;
 pub mod devices;
 pub mod gw1;
 pub mod hub;

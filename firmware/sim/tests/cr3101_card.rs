@@ -8,8 +8,10 @@ use cr3101::card::files::{Card, CardError};
 use cr3101::card::record::Record;
 use cr3101::card::sample::{layout, record};
 use embedded_sdmmc::{TimeSource, Timestamp};
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
+
+mod card_tools;
+use card_tools::{MIB, copy_out, fsck_clean, image, mtools};
 
 /// The clock the FAT directory entries take their times from.
 struct Clock;
@@ -20,43 +22,8 @@ impl TimeSource for Clock {
     }
 }
 
-const MIB: u64 = 1 << 20;
-
-fn image(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("coforge-card-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("card.img");
-    CardImage::create(&path, 16 * MIB, "CANMEM").unwrap();
-    path
-}
-
 fn mount(path: &Path) -> Card<CardImage, Clock> {
-    Card::mount(CardImage::open(path).unwrap(), Clock).unwrap()
-}
-
-/// mtools on the card's first partition (it starts at 1 MiB).
-fn mtools(tool: &str, path: &Path, args: &[&str]) -> std::process::Output {
-    let out = Command::new(tool).arg("-i").arg(format!("{}@@1M", path.display())).args(args).env("MTOOLS_SKIP_CHECK", "1").output();
-    let out = out.unwrap_or_else(|e| panic!("{tool}: {e} (cargo xtask test installs mtools)"));
-    assert!(out.status.success(), "{tool} {args:?}: {}", String::from_utf8_lossy(&out.stderr));
-    out
-}
-
-/// A file from the card, as a PC copies it.
-fn copy_out(path: &Path, name: &str) -> Vec<u8> {
-    let to = path.with_file_name(name);
-    mtools("mcopy", path, &["-n", &format!("::{name}"), to.to_str().unwrap()]);
-    std::fs::read(to).unwrap()
-}
-
-/// `fsck.fat -n` on the partition (copied out: fsck.fat takes no offset): clean or not.
-fn fsck_clean(path: &Path) -> bool {
-    let bytes = std::fs::read(path).unwrap();
-    let part = path.with_file_name("partition.img");
-    std::fs::write(&part, &bytes[MIB as usize..]).unwrap();
-    let out = Command::new("fsck.fat").arg("-n").arg(&part).output().expect("fsck.fat (cargo xtask test installs dosfstools)");
-    out.status.success()
+    Card::mount(CardImage::open(path).unwrap(), Clock).map_err(|(e, _)| e).unwrap()
 }
 
 #[test]

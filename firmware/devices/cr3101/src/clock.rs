@@ -132,6 +132,12 @@ fn to_ms(t: &TimeStamp) -> u64 {
     days * MS_PER_DAY + secs * 1000 + u64::from(t.millisecond)
 }
 
+/// The date and time `ms` milliseconds after 2000-01-01 00:00 (a host's clock, for a
+/// simulated board's RTC).
+pub fn at_ms_since_2000(ms: u64) -> TimeStamp {
+    of_ms(ms)
+}
+
 fn of_ms(ms: u64) -> TimeStamp {
     let (year, month, day) = date_of((ms / MS_PER_DAY) as i64);
     let in_day = ms % MS_PER_DAY;

@@ -34,6 +34,8 @@ pub struct Cr3101<B: Board, S: ParamStore> {
     board: B,
     /// The node-ID the pair holds until it is written: the board's factory setting.
     factory_node_id: u8,
+    /// The PDO operating mode a runtime chose over 20F5h (a simulator's `--mode`).
+    forced_mode: Option<Mode>,
     mode: Mode,
     bitrate_kbit: u16,
     /// The RPDOs' identifiers (1400h..1407h sub 1), when valid: which file a frame feeds.
@@ -67,6 +69,7 @@ impl<B: Board, S: ParamStore> Cr3101<B, S> {
             node: Node::new(od, store, node_config(factory_node_id)),
             board,
             factory_node_id,
+            forced_mode: None,
             mode: Mode::Logging,
             bitrate_kbit: 125,
             rpdo_ids: [None; FILES],
@@ -98,6 +101,12 @@ impl<B: Board, S: ParamStore> Cr3101<B, S> {
         &mut self.board
     }
 
+    /// Runs in `mode` from the next power-on, as if 20F5h said so (20F5h shows it too; it is
+    /// not saved).
+    pub fn set_pdo_mode(&mut self, mode: Mode) {
+        self.forced_mode = Some(mode);
+    }
+
     /// The PDO operating mode chosen at power-on (20F5h).
     pub fn mode(&self) -> Mode {
         self.mode
@@ -121,26 +130,32 @@ impl<B: Board, S: ParamStore> Cr3101<B, S> {
     /// Power-on: the stored parameters are loaded, the node-ID and bit rate taken from their
     /// pairs and the PDO operating mode from 20F5h, then CAN starts.
     fn power_on(&mut self, now_us: u64) {
-        self.node.power_on(now_us);
-        let factory = self.factory_node_id;
-        let od = self.node.od_mut();
-        if (od.node_id_setting, od.node_id_setting_shadow) == (SPEC_NODE_ID, SPEC_NODE_ID) {
-            (od.node_id_setting, od.node_id_setting_shadow) = (factory, factory);
-        }
-        let node_id = Self::pair(od.node_id_setting, od.node_id_setting_shadow, |id| (1..=127).contains(&id), factory);
+        self.load_parameters(now_us);
+        let od = self.node.od();
+        let node_id = Self::pair(od.node_id_setting, od.node_id_setting_shadow, |id| (1..=127).contains(&id), self.factory_node_id);
         let code = Self::pair(od.baud_rate_setting, od.baud_rate_setting_shadow, |c| bitrate_kbit(c).is_some(), SPEC_BITRATE);
         self.bitrate_kbit = bitrate_kbit(code).unwrap_or(125);
         // Mode 2 (the configurator's low-level access) is not documented: logging (CR-30).
         self.mode = if od.pdo_operating_mode == 1 { Mode::PdoRead } else { Mode::Logging };
         if node_id != self.node.node_id() {
             self.node.set_node_id(node_id);
-            self.node.power_on(now_us);
-            let od = self.node.od_mut();
-            if (od.node_id_setting, od.node_id_setting_shadow) == (SPEC_NODE_ID, SPEC_NODE_ID) {
-                (od.node_id_setting, od.node_id_setting_shadow) = (factory, factory);
-            }
+            self.load_parameters(now_us);
         }
         self.node.enable_can(self.mode, now_us);
+    }
+
+    /// The stored parameters over the spec defaults, then what the runtime set: the factory
+    /// node-ID in a pair that still holds the spec's, the mode it chose.
+    fn load_parameters(&mut self, now_us: u64) {
+        self.node.power_on(now_us);
+        let (factory, forced) = (self.factory_node_id, self.forced_mode);
+        let od = self.node.od_mut();
+        if (od.node_id_setting, od.node_id_setting_shadow) == (SPEC_NODE_ID, SPEC_NODE_ID) {
+            (od.node_id_setting, od.node_id_setting_shadow) = (factory, factory);
+        }
+        if let Some(mode) = forced {
+            od.pdo_operating_mode = u8::from(mode == Mode::PdoRead);
+        }
     }
 
     /// Reads the RPDOs' identifiers again (after anything that may have changed them).

@@ -201,7 +201,7 @@ impl<D: BlockDevice> Hooks for Logger<D> {
         match record.get(&layout, c) {
             Some(value) => read_slice(value, offset, buf),
             // Not relevant: zeros at the component's size (erratum CR-26).
-            None => read_slice(&[0; 4][..layout.types.get(c).map_or(2, |t| t.size())], offset, buf),
+            None => read_slice([0; 4].get(..layout.types.get(c).map_or(2, |t| t.size())).unwrap_or_default(), offset, buf),
         }
     }
 

@@ -17,18 +17,6 @@ static NOW: AtomicU32 = AtomicU32::new(0);
 #[derive(Debug, Clone, Copy, Default)]
 pub struct FatClock;
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_register_keeps_the_time_at_two_second_resolution() {
-        let t = Timestamp { year_since_1970: 56, zero_indexed_month: 11, zero_indexed_day: 2, hours: 6, minutes: 30, seconds: 59 };
-        FatClock::set(&t);
-        assert_eq!(FatClock.get_timestamp(), Timestamp { seconds: 58, ..t });
-    }
-}
-
 impl FatClock {
     /// Publishes `t` (two-second resolution, as FAT keeps it).
     pub fn set(t: &Timestamp) {
@@ -41,5 +29,17 @@ impl TimeSource for FatClock {
     fn get_timestamp(&self) -> Timestamp {
         let word = NOW.load(Ordering::Relaxed);
         Timestamp::from_fat((word >> 16) as u16, word as u16)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_register_keeps_the_time_at_two_second_resolution() {
+        let t = Timestamp { year_since_1970: 56, zero_indexed_month: 11, zero_indexed_day: 2, hours: 6, minutes: 30, seconds: 59 };
+        FatClock::set(&t);
+        assert_eq!(FatClock.get_timestamp(), Timestamp { seconds: 58, ..t });
     }
 }

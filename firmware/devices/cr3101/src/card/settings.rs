@@ -26,6 +26,7 @@ const MAGIC: [u8; 4] = *b"CMEM";
 const VERSION: u8 = 1;
 const FILES_AT: usize = 48;
 const CRC_AT: usize = FILES_AT + FILES * ENCODED_LEN;
+const _: () = assert!(CRC_AT + 2 <= LEN, "the configuration fits its file");
 
 /// What the configuration file holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,7 +102,6 @@ mod tests {
         s.allocation = [4096, 0, 1 << 20, 0, 0, 0, 0, 512];
         s.files[2].set_name(b"OIL_TEMP").unwrap();
         let bytes = s.encode();
-        assert!(CRC_AT + 2 <= LEN);
         assert_eq!(Settings::decode(&bytes), Some(s));
         assert_eq!(&bytes[..5], b"CMEM\x01");
         for at in [0, 4, 5, 20, FILES_AT + 3, CRC_AT, CRC_AT + 1] {

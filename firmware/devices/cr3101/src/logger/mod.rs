@@ -324,11 +324,10 @@ impl<D: BlockDevice> Logger<D> {
         if (before.name(), before.extension()) != (after.name(), after.extension()) {
             self.open_file(n, false).map_err(abort)?;
         }
-        if before.layout() != after.layout() || before.mode() != after.mode() || before.interval() != after.interval() {
-            if let Some(run) = self.runs.get_mut(n) {
-                *run = FileRun::new(after.layout());
-                run.restart(&after, self.now_us);
-            }
+        let restarts = before.layout() != after.layout() || before.mode() != after.mode() || before.interval() != after.interval();
+        if restarts && let Some(run) = self.runs.get_mut(n) {
+            *run = FileRun::new(after.layout());
+            run.restart(&after, self.now_us);
         }
         if before.write_pointer() != after.write_pointer() || before.count() != after.count() {
             // A file at its end logs again once its pointers are set back.
@@ -423,7 +422,7 @@ impl<D: BlockDevice> Logger<D> {
     pub fn end_input(&mut self, n: usize) {
         let window_zero = self.file(n).is_ok_and(|f| f.mode() == Mode::Autoincrement && f.interval() == 0);
         if window_zero && self.runs.get(n).is_some_and(FileRun::has_input) {
-            self.commit(n);
+            self.commit(n, self.now_us);
         }
     }
 
@@ -457,13 +456,14 @@ impl<D: BlockDevice> Logger<D> {
         self.save_at_us.get_or_insert(now.saturating_add(SAVE_DELAY_US));
     }
 
-    /// Writes file `n`'s pending record at its write pointer and moves on (cyclic writing at
-    /// each interval, autoincrement writing when its window closes).
-    fn commit(&mut self, n: usize) {
+    /// Writes file `n`'s pending record, stamped with the time it was due, at its write
+    /// pointer and moves on (cyclic writing at each interval, autoincrement writing when its
+    /// window closes).
+    fn commit(&mut self, n: usize, due_us: u64) {
         let Ok(file) = self.file(n).copied() else { return };
         let size = self.settings.allocation.get(n).copied().unwrap_or(0);
         let records = file.records(size);
-        let stamp = self.now();
+        let stamp = self.clock.now(due_us);
         let Some(run) = self.runs.get_mut(n) else { return };
         let now = self.now_us;
         let Commit { record, at } = match run.commit(&file, records, &stamp, now) {
@@ -488,10 +488,10 @@ impl<D: BlockDevice> Logger<D> {
             if let Some(run) = self.runs.get_mut(n) {
                 run.stop();
             }
-            if file.mode() == Mode::Autoincrement {
-                if let Some(f) = self.settings.files.get_mut(n) {
-                    f.switch_to_reading(at);
-                }
+            if file.mode() == Mode::Autoincrement
+                && let Some(f) = self.settings.files.get_mut(n)
+            {
+                f.switch_to_reading(at);
             }
         }
     }
@@ -504,8 +504,8 @@ impl<D: BlockDevice> Logger<D> {
         for n in 0..FILES {
             let Some(file) = self.settings.files.get(n).copied() else { continue };
             let due = self.runs.get(n).and_then(|r| r.due(&file, self.operational));
-            if due.is_some_and(|t| t <= now_us) {
-                self.commit(n);
+            if let Some(t) = due.filter(|&t| t <= now_us) {
+                self.commit(n, t);
             }
             let file = self.settings.files.get(n).copied().unwrap_or(file);
             let after = self.runs.get(n).and_then(|r| r.due(&file, self.operational));
