@@ -12,6 +12,8 @@ use cr3101::{Board, CardSense, Cr3101, StatusLeds};
 use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx};
 use std::io;
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The size of a card the simulator makes.
 pub const NEW_CARD_BYTES: u64 = 64 << 20;
@@ -19,22 +21,32 @@ pub const NEW_CARD_BYTES: u64 = 64 << 20;
 /// The simulated CR3101.
 pub type SimCr3101 = Cr3101<SimBoard, BlockStore<Eeprom>>;
 
-/// A card in the simulated slot: its image, and writes refused when its write-protect tab
-/// is set (the device should not write then; the card makes sure).
+/// A card in the simulated slot: its image; it stops answering the moment it leaves the
+/// slot, as a pulled card does, and refuses writes when its write-protect tab is set (the
+/// device should not write then; the card makes sure).
 #[derive(Debug)]
 pub struct SimCard {
     image: CardImage,
     read_only: bool,
+    in_slot: Arc<AtomicBool>,
+}
+
+impl SimCard {
+    fn check_in_slot(&self) -> io::Result<()> {
+        if self.in_slot.load(Ordering::Relaxed) { Ok(()) } else { Err(io::Error::new(io::ErrorKind::NotConnected, "the card was pulled")) }
+    }
 }
 
 impl BlockDevice for SimCard {
     type Error = io::Error;
 
     fn read(&self, blocks: &mut [Block], start: BlockIdx) -> io::Result<()> {
+        self.check_in_slot()?;
         self.image.read(blocks, start)
     }
 
     fn write(&self, blocks: &[Block], start: BlockIdx) -> io::Result<()> {
+        self.check_in_slot()?;
         if self.read_only {
             return Err(io::Error::new(io::ErrorKind::PermissionDenied, "the card is write-protected"));
         }
@@ -59,7 +71,8 @@ enum Image {
 #[derive(Debug)]
 pub struct SimBoard {
     image: Image,
-    in_slot: bool,
+    /// Shared with the card handed out, which fails once it is pulled.
+    in_slot: Arc<AtomicBool>,
     write_protected: bool,
     battery_ok: bool,
     leds: StatusLeds,
@@ -78,7 +91,7 @@ impl SimBoard {
             }
             None => Image::Memory(Some(CardImage::in_memory(NEW_CARD_BYTES, "CANMEM")?)),
         };
-        Ok(SimBoard { image, in_slot: true, write_protected: false, battery_ok: true, leds: StatusLeds::default() })
+        Ok(SimBoard { image, in_slot: Arc::new(AtomicBool::new(true)), write_protected: false, battery_ok: true, leds: StatusLeds::default() })
     }
 
     pub fn leds(&self) -> StatusLeds {
@@ -90,7 +103,7 @@ impl Board for SimBoard {
     type Card = SimCard;
 
     fn sense_card(&mut self) -> Option<CardSense> {
-        self.in_slot.then_some(CardSense { write_protected: self.write_protected })
+        self.in_slot.load(Ordering::Relaxed).then_some(CardSense { write_protected: self.write_protected })
     }
 
     fn take_card(&mut self) -> Option<SimCard> {
@@ -98,7 +111,7 @@ impl Board for SimBoard {
             Image::File(path) => CardImage::open(path).ok()?,
             Image::Memory(image) => image.take()?,
         };
-        Some(SimCard { image, read_only: self.write_protected })
+        Some(SimCard { image, read_only: self.write_protected, in_slot: self.in_slot.clone() })
     }
 
     fn return_card(&mut self, card: SimCard) {
@@ -132,11 +145,11 @@ impl Console for SimCr3101 {
         let board = self.board_mut();
         match words.as_slice() {
             ["card", "remove"] => {
-                board.in_slot = false;
+                board.in_slot.store(false, Ordering::Relaxed);
                 Ok("card removed".into())
             }
             ["card", "insert", rest @ ..] if rest.is_empty() || rest == ["protected"] => {
-                board.in_slot = true;
+                board.in_slot.store(true, Ordering::Relaxed);
                 board.write_protected = !rest.is_empty();
                 Ok(format!("card inserted{}", if rest.is_empty() { "" } else { ", write-protected" }))
             }

@@ -129,14 +129,22 @@ fn autoincrement_with_window_0_logs_every_rpdo_as_a_record_a_pc_reads_byte_for_b
         d.on_frame(&CanFrame::data(0x200 + u16::from(NODE), &payload(n)).unwrap(), now);
         want.extend_from_slice(expected(&layout, n, at_ms((n * 7) as u16)).as_bytes());
     }
+    // A frame shorter than the record's components (7 bytes): not logged, EMCY 8210h; the
+    // next whole one ends it.
+    d.on_frame(&CanFrame::data(0x200 + u16::from(NODE), &[1, 2, 3]).unwrap(), 360 * MS);
+    assert_eq!(emcys(&drain(&mut d, 360 * MS)), vec![[0x10, 0x82, 0x11, 0, 0, 0, 0, 0]]);
+    assert_eq!(u32_of(read(&mut d, 0x3005, 0).unwrap()), 50, "not logged");
+    d.on_frame(&CanFrame::data(0x200 + u16::from(NODE), &payload(50)).unwrap(), 370 * MS);
+    want.extend_from_slice(expected(&layout, 50, at_ms(370)).as_bytes());
+    assert_eq!(emcys(&drain(&mut d, 370 * MS)), vec![[0; 8]]);
     // A frame for file 2, which is not allocated: ignored.
     d.on_frame(&CanFrame::data(0x300 + u16::from(NODE), &[1, 2, 3, 4]).unwrap(), 400 * MS);
-    assert_eq!(u32_of(read(&mut d, 0x3005, 0).unwrap()), 50, "the write pointer");
-    assert_eq!(u32_of(read(&mut d, 0x3006, 0).unwrap()), 50, "records written");
+    assert_eq!(u32_of(read(&mut d, 0x3005, 0).unwrap()), 51, "the write pointer");
+    assert_eq!(u32_of(read(&mut d, 0x3006, 0).unwrap()), 51, "records written");
     // 5000h shows the last record written: its time stamp and values at their sizes.
-    assert_eq!(read(&mut d, 0x5000, 1).unwrap(), (343_u16).to_le_bytes(), "49 x 7 ms");
-    assert_eq!(read(&mut d, 0x5000, 9).unwrap(), (-49_000_i32).to_le_bytes(), "a DINT takes 4 bytes");
-    assert_eq!(read(&mut d, 0x5000, 11).unwrap(), [49], "a BYTE one");
+    assert_eq!(read(&mut d, 0x5000, 1).unwrap(), (370_u16).to_le_bytes());
+    assert_eq!(read(&mut d, 0x5000, 9).unwrap(), (-50_000_i32).to_le_bytes(), "a DINT takes 4 bytes");
+    assert_eq!(read(&mut d, 0x5000, 11).unwrap(), [50], "a BYTE one");
     assert_eq!(read(&mut d, 0x5000, 10).unwrap(), [0, 0], "component 3 is not relevant: a WORD of zeros");
     remove_card(&mut d, 2000 * MS);
 
@@ -319,4 +327,49 @@ fn the_node_id_comes_from_its_pair_at_the_next_power_on() {
     write(&mut d, 0x20F1, 0, &[0x33]).unwrap();
     d.start(0);
     assert_eq!(d.node().node_id(), 0x33);
+}
+
+#[test]
+fn records_logged_since_the_last_save_are_found_again_when_a_pulled_card_comes_back() {
+    let path = image("pulled");
+    let mut d = device(&path);
+    set_clock(&mut d, 0);
+    let layout = configure(&mut d, 0, b"PULLED", 0x03, 0, false, 50);
+    operational(&mut d, 0);
+    for n in 0..10_u32 {
+        d.on_frame(&CanFrame::data(0x200 + u16::from(NODE), &payload(n)).unwrap(), (10 + u64::from(n)) * MS);
+    }
+    // Pulled within the save delay: the pointers on the card still say 0.
+    d.console("card remove").unwrap();
+    drain(&mut d, 150 * MS);
+    assert_eq!(read(&mut d, 0x3005, 0), Err(SdoAbort::DataTransfer));
+    d.console("card insert").unwrap();
+    drain(&mut d, 300 * MS);
+    assert_eq!(u32_of(read(&mut d, 0x3005, 0).unwrap()), 10, "the ten records found again");
+    assert_eq!(u32_of(read(&mut d, 0x3006, 0).unwrap()), 10);
+    d.on_frame(&CanFrame::data(0x200 + u16::from(NODE), &payload(10)).unwrap(), 400 * MS);
+    remove_card(&mut d, 500 * MS);
+    let file = copy_out(&path, "PULLED.DAT");
+    for n in 0..10 {
+        assert_eq!(&file[n * 16..n * 16 + 16], expected(&layout, n as u32, at_ms(10 + n as u16)).as_bytes(), "record {n} kept");
+    }
+    assert_eq!(&file[160..176], expected(&layout, 10, at_ms(400)).as_bytes(), "logging went on after them");
+    assert!(fsck_clean(&path));
+}
+
+#[test]
+fn a_file_reset_with_55h_is_logged_over_from_record_0() {
+    let path = image("reset");
+    let mut d = device(&path);
+    set_clock(&mut d, 0);
+    configure(&mut d, 0, b"RESET", 0x03, 0, false, 50);
+    operational(&mut d, 0);
+    for n in 0..5_u32 {
+        d.on_frame(&CanFrame::data(0x200 + u16::from(NODE), &payload(n)).unwrap(), (10 + u64::from(n)) * MS);
+    }
+    write(&mut d, 0x3006, 0, &0x55_u32.to_le_bytes()).unwrap();
+    remove_card(&mut d, 2000 * MS);
+    d.console("card insert").unwrap();
+    drain(&mut d, 2200 * MS);
+    assert_eq!(u32_of(read(&mut d, 0x3005, 0).unwrap()), 0, "the old records are older than the reset: not found again");
 }

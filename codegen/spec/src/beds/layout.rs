@@ -22,7 +22,7 @@
 //!   default mapping), the image offset of the first mapped entry, and for a TPDO the event
 //!   timer (sub 5, ms) and the inhibit time (sub 3, converted from 100 us to ms).
 
-use super::dictionary::{Dictionary, Item};
+use super::dictionary::{Dictionary, Item, fixed_size};
 use crate::eds::ExportError;
 use crate::types::Access;
 use coforge_beds::{Dsat, GenericEntry, OdEntry, PdoRecord, SdoReply};
@@ -144,7 +144,11 @@ impl Image<'_> {
 
     /// Gives `item` its place (once) and lists it in its table.
     fn place(&mut self, item: &Item) -> Result<usize, ExportError> {
-        let size = self.size_of(item);
+        self.place_sized(item, self.size_of(item))
+    }
+
+    /// Gives `item` its place (once) at `size` bytes and lists it in its table.
+    fn place_sized(&mut self, item: &Item, size: usize) -> Result<usize, ExportError> {
         let at = match self.placed.get(&(item.index, item.sub)) {
             Some(&(at, _)) => at,
             None => {
@@ -186,13 +190,16 @@ pub fn lower(dict: &Dictionary, conventions: &Conventions) -> Result<Tables, Exp
     let mut first_offsets: BTreeMap<u16, usize> = BTreeMap::new();
     for maps in [&rpdo_maps, &tpdo_maps] {
         for (mapping, entries) in maps {
-            for (n, &(index, sub, _)) in entries.iter().enumerate() {
+            for (n, &(index, sub, bits)) in entries.iter().enumerate() {
                 if index <= 0x0007 {
                     continue; // a dummy takes no process data
                 }
                 let item =
                     dict.item(index, sub).ok_or_else(|| ExportError(format!("{mapping:04X}h maps {index:04X}h.{sub:02X}h, which the dictionary lacks")))?;
-                let at = image.place(item)?;
+                // A mapped string or domain takes what its PDO carries (an EDS cannot say its
+                // length; CR3101's components are mapped at their default type's size).
+                let size = if fixed_size(item.data_type).is_none() { usize::from(bits).div_ceil(8) } else { image.size_of(item) };
+                let at = image.place_sized(item, size)?;
                 if n == 0 {
                     first_offsets.insert(*mapping, at);
                 }

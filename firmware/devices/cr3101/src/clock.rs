@@ -142,15 +142,7 @@ fn of_ms(ms: u64) -> TimeStamp {
     let (year, month, day) = date_of((ms / MS_PER_DAY) as i64);
     let in_day = ms % MS_PER_DAY;
     let secs = in_day / 1000;
-    TimeStamp {
-        millisecond: (in_day % 1000) as u16,
-        second: (secs % 60) as u8,
-        minute: (secs / 60 % 60) as u8,
-        hour: (secs / 3600) as u8,
-        day,
-        month,
-        year,
-    }
+    TimeStamp { millisecond: (in_day % 1000) as u16, second: (secs % 60) as u8, minute: (secs / 60 % 60) as u8, hour: (secs / 3600) as u8, day, month, year }
 }
 
 impl Clock {

@@ -10,11 +10,12 @@ use crate::card::record::COMPONENTS;
 use crate::logger::{CardStatus, Logger};
 use crate::{Mode, Node, Od, emcy, node_config};
 use coforge_stack::device::{Device, NodeAccess};
-use coforge_stack::emcy::EmcyDefault;
+use coforge_stack::emcy::{EmcyDefault, EmcyEvent};
 use coforge_stack::frame::CanFrame;
 use coforge_stack::leds::Leds;
 use coforge_stack::nmt::NmtState;
 use coforge_stack::node::{BusState, NodeEvent, read_u32};
+use coforge_stack::od::NodeDictionary;
 use coforge_stack::store::ParamStore;
 
 /// The spec's default of 20F0h/20F1h and 20F2h/20F3h.
@@ -171,15 +172,27 @@ impl<B: Board, S: ParamStore> Cr3101<B, S> {
         self.rpdo_ids.iter().position(|&r| r == Some(id))
     }
 
-    /// Logging mode: RPDO n's payload, laid out as file n's record components, goes into
-    /// file n. Components the payload does not hold whole are not written; a file that takes
+    /// Logging mode: RPDO n's payload, laid out as file n's relevant components (as many as
+    /// fit 8 bytes), goes into file n. A payload shorter than that is not processed and gets
+    /// CiA 301's EMCY 8210h, which the next whole one ends (erratum CR-49); a file that takes
     /// no value (not allocated, direct reading, no card) ignores the frame.
     fn log(&mut self, n: usize, payload: &[u8]) {
+        let Ok(layout) = self.logger().file(n).map(|f| f.layout()) else { return };
+        let sizes = (0..COMPONENTS).filter_map(|c| layout.component(c).map(|r| (c, r.len())));
+        let carried = sizes.clone().scan(0, |end, (_, size)| {
+            *end += size;
+            (*end <= 8).then_some(*end)
+        });
+        let needed = carried.last().unwrap_or(0);
+        let length_error = EmcyDefault::for_event(EmcyEvent::RpdoLength, self.node.od().emergencies());
+        if payload.len() < needed {
+            self.node.raise(&length_error);
+            return;
+        }
+        self.mirror(&length_error, false);
         let logger = self.logger_mut();
-        let Ok(layout) = logger.file(n).map(|f| f.layout()) else { return };
         let mut at = 0;
-        for c in 0..COMPONENTS {
-            let Some(size) = layout.component(c).map(|r| r.len()) else { continue };
+        for (c, size) in sizes {
             let Some(value) = payload.get(at..at + size) else { break };
             at += size;
             if logger.write_component(n, c, value).is_err() {
@@ -260,7 +273,11 @@ impl<B: Board, S: ParamStore> Cr3101<B, S> {
             }
             let full = conditions.file_full & bit != 0;
             if full != (self.full_reported & bit != 0) {
-                if full { self.node.raise(&e) } else { self.node.clear(&e) }
+                if full {
+                    self.node.raise(&e)
+                } else {
+                    self.node.clear(&e)
+                }
                 self.full_reported ^= bit;
             }
         }

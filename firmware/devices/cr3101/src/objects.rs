@@ -6,10 +6,10 @@
 use crate::app::Hooks;
 use crate::card::files::FILES;
 use crate::card::record::COMPONENTS;
+use crate::card::record::ComponentType;
 use crate::clock::Field;
 use crate::logger::Logger;
 use crate::logger::file_config::{Component, RING, Text};
-use crate::card::record::ComponentType;
 use coforge_stack::od::{ReadLen, SdoAbort, read_slice};
 use embedded_sdmmc::BlockDevice;
 

@@ -8,6 +8,6 @@
 pub mod fat_clock;
 pub mod files;
 pub mod record;
-pub mod settings;
 #[cfg(feature = "card-sample")]
 pub mod sample;
+pub mod settings;

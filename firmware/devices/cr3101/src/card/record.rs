@@ -85,6 +85,13 @@ pub struct TimeStamp {
 }
 
 impl TimeStamp {
+    /// Orders time stamps: later ones have greater keys.
+    pub fn order_key(&self) -> u64 {
+        let date = u64::from(self.year) << 16 | u64::from(self.month) << 8 | u64::from(self.day);
+        let time = u64::from(self.hour) << 24 | u64::from(self.minute) << 16 | u64::from(self.second) << 10 | u64::from(self.millisecond);
+        date << 32 | time
+    }
+
     pub fn encode(&self) -> [u8; TIME_STAMP] {
         let [m0, m1] = self.millisecond.to_le_bytes();
         [m0, m1, self.second, self.minute, self.hour, self.day, self.month, self.year]

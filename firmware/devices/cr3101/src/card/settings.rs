@@ -10,11 +10,13 @@
 //! | 5..16 | 2000h card name (NUL-padded) |
 //! | 16..48 | 2002h.1..8 file sizes, u32 little-endian |
 //! | 48..936 | files 1..8, 111 bytes each ([`FileConfig::encode`]) |
-//! | 936..938 | CRC-16/XMODEM of bytes 0..936, little-endian |
+//! | 936..944 | when it was saved: a time stamp as the records have it |
+//! | 944..946 | CRC-16/XMODEM of bytes 0..944, little-endian |
 //!
 //! The file is pre-allocated at 1024 bytes and rewritten in place, like the record files.
 
 use super::files::FILES;
+use super::record::{TIME_STAMP, TimeStamp};
 use crate::logger::file_config::{ENCODED_LEN, FileConfig, Text};
 use coforge_link::crc::CCITT;
 
@@ -25,7 +27,8 @@ pub const LEN: usize = 1024;
 const MAGIC: [u8; 4] = *b"CMEM";
 const VERSION: u8 = 1;
 const FILES_AT: usize = 48;
-const CRC_AT: usize = FILES_AT + FILES * ENCODED_LEN;
+const SAVED_AT: usize = FILES_AT + FILES * ENCODED_LEN;
+const CRC_AT: usize = SAVED_AT + TIME_STAMP;
 const _: () = assert!(CRC_AT + 2 <= LEN, "the configuration fits its file");
 
 /// What the configuration file holds.
@@ -36,6 +39,9 @@ pub struct Settings {
     /// The file sizes in effect (2002h/2003h when they agree).
     pub allocation: [u32; FILES],
     pub files: [FileConfig; FILES],
+    /// When the file was written: records on the card older than this were logged before
+    /// it, and its pointers count them.
+    pub saved_at: TimeStamp,
 }
 
 impl Settings {
@@ -46,6 +52,7 @@ impl Settings {
             name: Text::new(b"00000000000").unwrap_or_default(),
             allocation: [0; FILES],
             files: core::array::from_fn(FileConfig::factory),
+            saved_at: TimeStamp::default(),
         }
     }
 
@@ -65,6 +72,7 @@ impl Settings {
         for (n, file) in self.files.iter().enumerate() {
             put(&mut out, FILES_AT + n * ENCODED_LEN, &file.encode());
         }
+        put(&mut out, SAVED_AT, &self.saved_at.encode());
         let crc = CCITT.checksum(out.get(..CRC_AT).unwrap_or_default());
         put(&mut out, CRC_AT, &crc.to_le_bytes());
         out
@@ -87,6 +95,7 @@ impl Settings {
             let at = FILES_AT + n * ENCODED_LEN;
             *file = FileConfig::decode(bytes.get(at..at + ENCODED_LEN)?.try_into().ok()?)?;
         }
+        settings.saved_at = TimeStamp::decode(bytes.get(SAVED_AT..CRC_AT)?.try_into().ok()?);
         Some(settings)
     }
 }
@@ -101,10 +110,11 @@ mod tests {
         s.name = Text::new(b"TRUCK 17").unwrap();
         s.allocation = [4096, 0, 1 << 20, 0, 0, 0, 0, 512];
         s.files[2].set_name(b"OIL_TEMP").unwrap();
+        s.saved_at = TimeStamp { millisecond: 1, second: 2, minute: 3, hour: 4, day: 5, month: 6, year: 26 };
         let bytes = s.encode();
         assert_eq!(Settings::decode(&bytes), Some(s));
         assert_eq!(&bytes[..5], b"CMEM\x01");
-        for at in [0, 4, 5, 20, FILES_AT + 3, CRC_AT, CRC_AT + 1] {
+        for at in [0, 4, 5, 20, FILES_AT + 3, SAVED_AT, CRC_AT, CRC_AT + 1] {
             let mut bad = bytes;
             bad[at] ^= 0x10;
             assert_eq!(Settings::decode(&bad), None, "byte {at} flipped");

@@ -25,6 +25,9 @@ use pair::RedundantPair;
 /// How long pointers that moved wait before they are saved to the card (erratum CR-48):
 /// a record every millisecond must not cost a configuration write every millisecond.
 const SAVE_DELAY_US: u64 = 1_000_000;
+/// How far past its saved write pointer a file is searched for records written after the
+/// save: more than a second of records at the manual's one per millisecond.
+const RECOVER_RECORDS: u32 = 2048;
 
 /// What the card slot shows (2001h, 1002h).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -196,8 +199,52 @@ impl<D: BlockDevice> Logger<D> {
                 *run = FileRun::new(file.layout());
                 run.restart(file, now);
             }
+            self.recover_pointers(n);
         }
         Ok(())
+    }
+
+    /// Finds the records written after the configuration file was last saved (the card was
+    /// pulled, or the power lost, within the save delay; erratum CR-48): from the saved write
+    /// pointer on, every record that holds a written component and is neither older than the
+    /// save nor than the record before it, so that logging goes on after them instead of over
+    /// them.
+    fn recover_pointers(&mut self, n: usize) {
+        let Ok(file) = self.file(n).copied() else { return };
+        let records = file.records(self.settings.allocation.get(n).copied().unwrap_or(0));
+        if !matches!(file.mode(), Mode::Cyclic | Mode::Autoincrement) || records == 0 {
+            return;
+        }
+        let layout = file.layout();
+        let len = layout.len() as u32;
+        let mut bytes = [0; crate::card::record::MAX_RECORD];
+        let Some(card) = self.card.as_mut() else { return };
+        let mut read = |at: u32| {
+            let buf = bytes.get_mut(..len as usize)?;
+            card.read_at(n, at.checked_mul(len)?, buf).ok()?;
+            Record::from_bytes(&layout, buf)
+        };
+        let (mut at, mut count) = (file.write_pointer(), file.count());
+        let mut last = self.settings.saved_at.order_key();
+        for _ in 0..RECOVER_RECORDS.min(records) {
+            if at >= records {
+                if !file.ring {
+                    break;
+                }
+                at = 0;
+            }
+            let Some(record) = read(at).filter(|r| r.modified() != 0) else { break };
+            let key = record.time_stamp().order_key();
+            if key < last {
+                break;
+            }
+            last = key;
+            at += 1;
+            count = count.max(at);
+        }
+        if (at, count) != (file.write_pointer(), file.count()) {
+            self.advance(n, |f| f.set_progress(at, count));
+        }
     }
 
     /// The card is to be removed, or was: moved pointers are saved while it still can be,
@@ -255,6 +302,7 @@ impl<D: BlockDevice> Logger<D> {
         if self.status.write_protected {
             return Ok(());
         }
+        self.settings.saved_at = self.now();
         let bytes = self.settings.encode();
         let card = self.card.as_mut().ok_or(CardError::NoVolume)?;
         card.write_at(SETTINGS_SLOT, 0, &bytes).inspect_err(|_| self.card_errors = self.card_errors.wrapping_add(1))
@@ -352,6 +400,11 @@ impl<D: BlockDevice> Logger<D> {
     fn load_shown(&mut self, n: usize) -> Result<(), SdoAbort> {
         let file = *self.file(n)?;
         let layout = file.layout();
+        let size = self.settings.allocation.get(n).copied().unwrap_or(0);
+        if file.current() >= file.records(size) {
+            // A file without records (not allocated) has no record to show.
+            return Err(SdoAbort::NoData);
+        }
         let mut bytes = [0; crate::card::record::MAX_RECORD];
         let len = layout.len();
         let at = file.current().checked_mul(len as u32).ok_or(SdoAbort::ValueTooHigh)?;
