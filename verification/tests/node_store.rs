@@ -3,7 +3,8 @@
 
 use co401gw1::{Mode, Od};
 use coforge_stack::od::{AccessContext, Area, EntryAccess, NmtState, NoAppObjects, Side};
-use coforge_stack::store::{BlockStore, ParamStore};
+use coforge_stack::od::NodeDictionary;
+use coforge_stack::store::{BlockStore, MAX_SLOTS, ParamStore};
 use coforge_storage::ram::RamEeprom;
 
 const PREOP: AccessContext = AccessContext { nmt: NmtState::PreOperational, can_enabled: true };
@@ -82,6 +83,75 @@ impl embedded_storage::Storage for Torn {
     }
 }
 
+/// Bytes of one slot: header and block.
+const SLOT: usize = 12 + <Od<NoAppObjects> as NodeDictionary>::PERSISTENT_SIZE;
+
+/// A storage device that counts the writes that land in each slot.
+#[derive(Debug)]
+struct Counting {
+    image: RamEeprom<[u8; 2048]>,
+    writes: Vec<usize>,
+}
+
+impl embedded_storage::ReadStorage for Counting {
+    type Error = ();
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), ()> {
+        self.image.read(offset, bytes).map_err(|_| ())
+    }
+    fn capacity(&self) -> usize {
+        self.image.capacity()
+    }
+}
+
+impl embedded_storage::Storage for Counting {
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), ()> {
+        let slot = offset as usize / SLOT;
+        if self.writes.len() <= slot {
+            self.writes.resize(slot + 1, 0);
+        }
+        self.writes[slot] += 1;
+        self.image.write(offset, bytes).map_err(|_| ())
+    }
+}
+
+#[test]
+fn saves_go_round_the_ring_and_a_save_of_what_is_stored_writes_nothing() {
+    let slots = (2048 / SLOT).min(MAX_SLOTS as usize);
+    assert!(slots > 2, "{slots} slots of {SLOT} bytes");
+    let mut store = BlockStore::new(Counting { image: RamEeprom::new(), writes: Vec::new() }, 0);
+    for n in 0..3 * slots as u16 {
+        store.save(&od_with_guard_time(100 + n), Area::ALL).expect("fits");
+        // The same values again: nothing written.
+        let before = store.storage().writes.clone();
+        store.save(&od_with_guard_time(100 + n), Area::ALL).expect("fits");
+        assert_eq!(store.storage().writes, before, "save {n} repeated");
+    }
+    let writes = &store.storage().writes;
+    assert_eq!(writes.len(), slots, "every slot used, none past the ring");
+    assert!(writes.iter().all(|&w| w == writes[0]), "each slot written as often as the others: {writes:?}");
+    let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
+    assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true));
+    assert_eq!(guard_time(&mut fresh), 100 + 3 * slots as u16 - 1, "the newest after the ring wrapped three times");
+}
+
+#[test]
+fn restoring_the_defaults_is_one_marker_and_the_next_save_stores_everything() {
+    let mut store = BlockStore::new(Counting { image: RamEeprom::new(), writes: Vec::new() }, 0);
+    for n in 0..5 {
+        store.save(&od_with_guard_time(700 + n), Area::ALL).expect("fits");
+    }
+    let before: usize = store.storage().writes.iter().sum();
+    store.erase(&Od::new(Mode::Mixed, 5, NoAppObjects)).expect("erased");
+    assert_eq!(store.storage().writes.iter().sum::<usize>() - before, 2, "the marker's slot header, cleared then written");
+    let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
+    assert_eq!(store.load(&mut fresh, Area::ALL), Ok(false), "nothing stored: the defaults");
+    assert!(!store.is_valid(<Od<NoAppObjects> as NodeDictionary>::PERSISTENT_SIZE).unwrap());
+    // Saving one area after the restore stores every area (there is no block to keep).
+    store.save(&od_with_guard_time(900), Area::MANUFACTURER).expect("fits");
+    assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true));
+    assert_eq!(guard_time(&mut fresh), 900);
+}
+
 fn od_with_guard_time(ms: u16) -> Od<NoAppObjects> {
     let mut od = Od::new(Mode::Mixed, 5, NoAppObjects);
     od.write(0x100C, 0, &ms.to_le_bytes(), Side::Bus, &PREOP).expect("writable in pre-operational");
@@ -115,9 +185,9 @@ fn the_newest_block_wins_and_a_corrupt_newest_falls_back_to_the_previous() {
     let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
     assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true));
     assert_eq!(guard_time(&mut fresh), 900, "three saves: the last one wins");
-    // The third save went to slot 0 again; corrupt its data.
+    // The third save went to the third slot of the ring; corrupt its data.
     let mut image = store.into_inner();
-    image.as_bytes_mut()[12] ^= 0xFF;
+    image.as_bytes_mut()[2 * SLOT + 12] ^= 0xFF;
     let mut store = BlockStore::new(image, 0);
     let mut fresh = Od::new(Mode::Mixed, 5, NoAppObjects);
     assert_eq!(store.load(&mut fresh, Area::ALL), Ok(true));
@@ -138,30 +208,6 @@ fn saving_one_area_keeps_the_others_from_the_previous_block() {
     assert_eq!(u16::from_le_bytes(buf), 2000, "manufacturer area saved now");
 }
 
-/// A storage device that counts its writes.
-#[derive(Debug)]
-struct Counting {
-    image: RamEeprom<[u8; 2048]>,
-    writes: usize,
-}
-
-impl embedded_storage::ReadStorage for Counting {
-    type Error = ();
-    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), ()> {
-        self.image.read(offset, bytes).map_err(|_| ())
-    }
-    fn capacity(&self) -> usize {
-        self.image.capacity()
-    }
-}
-
-impl embedded_storage::Storage for Counting {
-    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), ()> {
-        self.writes += 1;
-        self.image.write(offset, bytes).map_err(|_| ())
-    }
-}
-
 #[test]
 fn a_save_gathers_the_entries_into_few_writes_of_the_same_bytes() {
     use coforge_stack::od::NodeDictionary;
@@ -172,9 +218,10 @@ fn a_save_gathers_the_entries_into_few_writes_of_the_same_bytes() {
         expected[at..at + bytes.len()].copy_from_slice(bytes);
         true
     }));
-    let mut store = BlockStore::new(Counting { image: RamEeprom::new(), writes: 0 }, 0);
+    let mut store = BlockStore::new(Counting { image: RamEeprom::new(), writes: Vec::new() }, 0);
     store.save(&od, Area::ALL).expect("fits");
     let Counting { image, writes } = store.into_inner();
+    let writes: usize = writes.iter().sum();
     // An EEPROM write cycle (some 5 ms) per write: two headers and the data gathered into
     // pieces of up to 32 bytes (each more than 16 full), not one write per entry (272).
     assert!(writes <= 2 + len.div_ceil(16), "{writes} writes for {len} bytes");

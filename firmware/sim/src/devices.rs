@@ -137,7 +137,8 @@ fn build_cr3101(name: &'static str, mode: Option<&str>, node_id: u8, store: &Sto
         format!("{name} has no mode `{}`; its modes are: {}", given.unwrap_or_default(), known.join(", "))
     })?;
     let size = <Dictionary as NodeDictionary>::PERSISTENT_SIZE;
-    let request = MemoryRequest { name: "parameters", capacity: BlockStore::<Eeprom>::capacity_for(size) };
+    // Saved at every write (automatic save): a ring of slots spreads the wear.
+    let request = MemoryRequest { name: "parameters", capacity: BlockStore::<Eeprom>::capacity_for_slots(size, coforge_stack::store::MAX_SLOTS) };
     let storage = eeprom(store, request)?;
     let board = SimBoard::new(card.map(Path::to_path_buf)).map_err(|e| format!("{name}: card image: {e}"))?;
     let mut device = SimCr3101::new(board, BlockStore::new(storage, 0), node_id);

@@ -1,19 +1,28 @@
 //! The parameter block of 1010h/1011h on any `embedded-storage` device (EEPROM, flash
 //! emulation, a file on a PC).
 //!
-//! Two slots alternate, each a header (magic "CFG1", block length u32 LE, CRC-16/XMODEM u16
-//! LE, sequence number u16 LE) and the data as [`NodeDictionary::save_area`] lays it out. The CRC
-//! covers length, sequence and data. A save writes the slot that does not hold the newest
-//! valid block, and its header last, so a save torn by a reset or a storage error leaves the
-//! previous block in place. A slot whose magic, length or CRC does not match is ignored; with
-//! no valid slot the node keeps the spec defaults instead of loading garbage.
+//! A ring of slots (two, or as many as the storage holds up to [`MAX_SLOTS`]), each a header
+//! (magic "CFG1", block length u32 LE, CRC-16/XMODEM u16 LE, sequence number u16 LE) and the
+//! data as [`NodeDictionary::save_area`] lays it out. The CRC covers length, sequence and
+//! data. A save writes the slot after the one holding the newest valid block, and its header
+//! last, so a save torn by a reset or a storage error leaves the previous block in place; the
+//! ring spreads the writes over every slot, so that a device which saves on every write
+//! (CR3101's automatic save) wears each cell once per ring turn, not once per write. A save
+//! that would store what the newest block already holds writes nothing. A slot whose magic,
+//! length or CRC does not match is ignored; with no valid slot the node keeps the spec
+//! defaults instead of loading garbage. Restoring the defaults (1011h) writes an erase marker
+//! (magic "CFGE", no data) into the next slot: one write, however many slots there are.
 
 use crate::od::{Area, NodeDictionary};
 use coforge_link::crc::{Crc16, XMODEM};
 use embedded_storage::Storage;
 
 const MAGIC: [u8; 4] = *b"CFG1";
+/// A block that says "nothing stored": the defaults were restored.
+const ERASED: [u8; 4] = *b"CFGE";
 const HEADER: u32 = 12;
+/// The most slots a store uses: every one is read at power-on.
+pub const MAX_SLOTS: u32 = 16;
 static CRC: Crc16 = Crc16::new(XMODEM);
 
 /// Why the parameter store failed.
@@ -77,11 +86,12 @@ pub struct BlockStore<S> {
     base: u32,
 }
 
-/// The slot holding the newest valid block.
+/// The slot holding the newest valid block, and whether that block is an erase marker.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Newest {
     slot: u32,
     seq: u16,
+    erased: bool,
 }
 
 impl<S: Storage> BlockStore<S> {
@@ -91,7 +101,20 @@ impl<S: Storage> BlockStore<S> {
 
     /// Bytes of storage the two slots of a `len`-byte block take.
     pub const fn capacity_for(len: usize) -> usize {
-        2 * (HEADER as usize + len)
+        Self::capacity_for_slots(len, 2)
+    }
+
+    /// Bytes of storage `slots` slots of a `len`-byte block take (a store uses as many slots
+    /// as its storage holds, up to [`MAX_SLOTS`]).
+    pub const fn capacity_for_slots(len: usize, slots: u32) -> usize {
+        slots as usize * (HEADER as usize + len)
+    }
+
+    /// The slots a `len`-byte block has: as many as fit after `base`, at most [`MAX_SLOTS`].
+    fn slots(&self, len: usize) -> u32 {
+        let size = HEADER as usize + len;
+        let room = self.storage.capacity().saturating_sub(self.base as usize) / size;
+        u32::try_from(room).unwrap_or(MAX_SLOTS).min(MAX_SLOTS)
     }
 
     pub fn storage(&self) -> &S {
@@ -102,7 +125,7 @@ impl<S: Storage> BlockStore<S> {
         self.storage
     }
 
-    /// Where slot 0 or 1 of a `len`-byte block starts.
+    /// Where slot `slot` of a `len`-byte block starts.
     fn slot_at(&self, slot: u32, len: usize) -> Result<u32, StoreError> {
         let size = HEADER.checked_add(u32::try_from(len).map_err(|_| StoreError::TooSmall)?).ok_or(StoreError::TooSmall)?;
         self.base.checked_add(slot * size).ok_or(StoreError::TooSmall)
@@ -133,29 +156,55 @@ impl<S: Storage> BlockStore<S> {
         Ok(CRC.finish(crc))
     }
 
-    /// The sequence number of the slot's block, if it holds a valid `len`-byte block.
-    fn valid_seq(&mut self, slot: u32, len: usize) -> Result<Option<u16>, StoreError> {
+    /// The slot's block, if it holds a valid `len`-byte block or an erase marker.
+    fn valid(&mut self, slot: u32, len: usize) -> Result<Option<Newest>, StoreError> {
         let at = self.slot_at(slot, len)?;
         let (magic, stored_len, crc, seq) = self.header(at)?;
-        if magic != MAGIC || usize::try_from(stored_len).ok() != Some(len) {
-            return Ok(None);
-        }
-        Ok((self.slot_crc(at, len, seq)? == crc).then_some(seq))
+        let valid = match magic {
+            MAGIC => usize::try_from(stored_len).ok() == Some(len) && self.slot_crc(at, len, seq)? == crc,
+            ERASED => stored_len == 0 && self.slot_crc(at, 0, seq)? == crc,
+            _ => false,
+        };
+        Ok(valid.then_some(Newest { slot, seq, erased: magic == ERASED }))
     }
 
-    /// The slot with the newest valid block (sequence numbers compared with wrap-around).
+    /// The slot with the newest valid block (sequence numbers compared with wrap-around: the
+    /// ring's valid blocks hold at most [`MAX_SLOTS`] consecutive numbers).
     fn newest(&mut self, len: usize) -> Result<Option<Newest>, StoreError> {
-        let a = self.valid_seq(0, len)?.map(|seq| Newest { slot: 0, seq });
-        let b = self.valid_seq(1, len)?.map(|seq| Newest { slot: 1, seq });
-        Ok(match (a, b) {
-            (Some(a), Some(b)) => Some(if b.seq.wrapping_sub(a.seq) as i16 > 0 { b } else { a }),
-            (a, b) => a.or(b),
-        })
+        let mut newest: Option<Newest> = None;
+        for slot in 0..self.slots(len) {
+            if let Some(b) = self.valid(slot, len)? {
+                newest = match newest {
+                    Some(a) if b.seq.wrapping_sub(a.seq) as i16 <= 0 => Some(a),
+                    _ => Some(b),
+                };
+            }
+        }
+        Ok(newest)
     }
 
     /// Whether a valid block of `len` bytes is stored.
     pub fn is_valid(&mut self, len: usize) -> Result<bool, StoreError> {
-        Ok(self.newest(len)?.is_some())
+        Ok(self.newest(len)?.is_some_and(|n| !n.erased))
+    }
+
+    /// Whether the newest block `newest` already holds what `od` would save of `area`.
+    fn holds(&mut self, newest: Newest, od: &dyn DictionaryImage, area: Area) -> Result<bool, StoreError> {
+        let from = self.slot_at(newest.slot, od.size())?;
+        let mut stored = [0_u8; GATHER];
+        let storage = &mut self.storage;
+        let same = od.save_area(area, &mut |offset, image| {
+            // Compared a chunk at a time; any difference ends the walk.
+            image.chunks(GATHER).enumerate().all(|(i, piece)| {
+                let at = data_at(from, offset + i * GATHER);
+                let buf = stored.get_mut(..piece.len());
+                match (at, buf) {
+                    (Ok(at), Some(buf)) => storage.read(at, buf).is_ok() && buf == piece,
+                    _ => false,
+                }
+            })
+        });
+        Ok(same)
     }
 
     fn write_header(&mut self, at: u32, magic: [u8; 4], len: usize, crc: u16, seq: u16) -> Result<(), StoreError> {
@@ -236,18 +285,25 @@ fn data_at(slot_at: u32, offset: usize) -> Result<u32, StoreError> {
 impl<S: Storage> ParamStore for BlockStore<S> {
     fn save(&mut self, od: &dyn DictionaryImage, area: Area) -> Result<(), StoreError> {
         let len = od.size();
-        let end = usize::try_from(self.slot_at(2, len)?).map_err(|_| StoreError::TooSmall)?;
-        if end > self.storage.capacity() {
+        let slots = self.slots(len);
+        if slots < 2 {
             return Err(StoreError::TooSmall);
         }
         let newest = self.newest(len)?;
-        let target_slot = newest.map_or(0, |n| 1 - n.slot);
+        if let Some(n) = newest.filter(|n| !n.erased)
+            && self.holds(n, od, area)?
+        {
+            // Nothing changed: nothing is written (a master writing the same configuration
+            // at every start wears nothing).
+            return Ok(());
+        }
+        let target_slot = newest.map_or(0, |n| (n.slot + 1) % slots);
         let target = self.slot_at(target_slot, len)?;
         // The newest block stays valid until the new header is written.
         self.write_header(target, [0; 4], len, 0, 0)?;
         let area = match newest {
             // Only some areas change: start from the newest block's contents.
-            Some(n) if area != Area::ALL => {
+            Some(n) if area != Area::ALL && !n.erased => {
                 let from = self.slot_at(n.slot, len)?;
                 self.copy_data(from, target, len)?;
                 area
@@ -271,7 +327,7 @@ impl<S: Storage> ParamStore for BlockStore<S> {
 
     fn load(&mut self, od: &mut dyn DictionaryImage, area: Area) -> Result<bool, StoreError> {
         let len = od.size();
-        let Some(newest) = self.newest(len)? else { return Ok(false) };
+        let Some(newest) = self.newest(len)?.filter(|n| !n.erased) else { return Ok(false) };
         let from = self.slot_at(newest.slot, len)?;
         let loaded = od.load_area(area, &mut |offset, buf| data_at(from, offset).is_ok_and(|at| self.storage.read(at, buf).is_ok()));
         if loaded { Ok(true) } else { Err(StoreError::Device) }
@@ -279,10 +335,18 @@ impl<S: Storage> ParamStore for BlockStore<S> {
 
     fn erase(&mut self, od: &dyn DictionaryImage) -> Result<(), StoreError> {
         let len = od.size();
-        for slot in [0, 1] {
-            let at = self.slot_at(slot, len)?;
-            self.write_header(at, [0; 4], 0, 0, 0)?;
+        let slots = self.slots(len);
+        match self.newest(len)? {
+            None => Ok(()),
+            Some(n) if n.erased => Ok(()),
+            Some(n) => {
+                // The marker goes into the next slot; the block stays valid until it is written.
+                let seq = n.seq.wrapping_add(1);
+                let at = self.slot_at((n.slot + 1) % slots.max(1), len)?;
+                self.write_header(at, [0; 4], 0, 0, 0)?;
+                let crc = self.slot_crc(at, 0, seq)?;
+                self.write_header(at, ERASED, 0, crc, seq)
+            }
         }
-        Ok(())
     }
 }
