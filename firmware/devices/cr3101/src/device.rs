@@ -123,7 +123,7 @@ impl<B: Board, S: ParamStore> Cr3101<B, S> {
     }
 
     /// A redundant pair's value at power-on: both halves agreeing on a value `valid` takes;
-    /// otherwise `fallback` (erratum CR-46).
+    /// otherwise `fallback` (erratum CR-47).
     fn pair(first: u8, second: u8, valid: impl Fn(u8) -> bool, fallback: u8) -> u8 {
         if first == second && valid(first) { first } else { fallback }
     }

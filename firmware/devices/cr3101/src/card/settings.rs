@@ -1,4 +1,4 @@
-//! The card's own configuration, `CANMEM.CFG` in the root directory (erratum CR-47): the card
+//! The card's own configuration, `CANMEM.CFG` in the root directory (erratum CR-48): the card
 //! name (2000h), the allocation in effect (2002h/2003h) and every file's configuration and
 //! pointers (3x00h..3x1ch). It travels with the card, as the manual has it, and a PC tool
 //! reads it with the record files.

@@ -308,7 +308,7 @@ impl<D: BlockDevice> Logger<D> {
         card.write_at(SETTINGS_SLOT, 0, &bytes).inspect_err(|_| self.card_errors = self.card_errors.wrapping_add(1))
     }
 
-    /// A configuration write: it needs a card, and is saved on it at once (erratum CR-47).
+    /// A configuration write: it needs a card, and is saved on it at once (erratum CR-48).
     fn configure(&mut self, change: impl FnOnce(&mut Settings) -> Result<(), SdoAbort>) -> Result<(), SdoAbort> {
         self.card()?;
         let mut settings = self.settings;
