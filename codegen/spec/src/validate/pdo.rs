@@ -73,12 +73,8 @@ pub fn mapping_length(d: &Device, diags: &mut Diagnostics) {
         let variable = entry.is_some_and(|e| e.data_type.bits().is_none());
         let fits = |bits: u32| if variable { m.bits % 8 == 0 && m.bits > 0 && u32::from(m.bits) <= bits } else { u32::from(m.bits) == bits };
         if let Some(bits) = want.filter(|&b| !fits(b)) {
-            let up_to = if variable { "up to " } else { "" };
-            diags.push(Diagnostic::error(
-                "pdo-mapping-length",
-                m.span,
-                format!("{} with {} bits, but the entry takes {up_to}{bits} bits", mapped(pdo, m), m.bits),
-            ));
+            let is = if variable { "takes whole bytes up to" } else { "is" };
+            diags.push(Diagnostic::error("pdo-mapping-length", m.span, format!("{} with {} bits, but the entry {is} {bits} bits", mapped(pdo, m), m.bits)));
         }
     });
 }
