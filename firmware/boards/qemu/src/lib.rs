@@ -7,6 +7,7 @@
 
 pub mod bench;
 pub mod clock;
+pub mod cr3101_board;
 pub mod host_file;
 pub mod line_console;
 pub mod mmio;
