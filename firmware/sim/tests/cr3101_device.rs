@@ -373,3 +373,48 @@ fn a_file_reset_with_55h_is_logged_over_from_record_0() {
     drain(&mut d, 2200 * MS);
     assert_eq!(u32_of(read(&mut d, 0x3005, 0).unwrap()), 0, "the old records are older than the reset: not found again");
 }
+
+#[test]
+fn a_new_allocation_empties_its_file_and_a_full_card_refuses_what_does_not_fit() {
+    let path = image("allocation");
+    let mut d = device(&path);
+    set_clock(&mut d, 0);
+    configure(&mut d, 0, b"FIRST", 0x01, 1, false, 10);
+    write(&mut d, 0x5000, 8, &[0x11, 0x22]).unwrap();
+    // One half alone changes nothing; both halves re-lay the file out, emptied.
+    write(&mut d, 0x2002, 1, &320_u32.to_le_bytes()).unwrap();
+    assert_eq!(u32_of(read(&mut d, 0x2003, 1).unwrap()), 160);
+    assert_eq!(read(&mut d, 0x5000, 8).unwrap(), [0x11, 0x22], "still the old file");
+    write(&mut d, 0x2003, 1, &320_u32.to_le_bytes()).unwrap();
+    assert_eq!(read(&mut d, 0x5000, 8).unwrap(), [0, 0], "emptied");
+    // 16 MiB card: a 20 MiB file does not fit. The pair takes effect and the card refuses.
+    write(&mut d, 0x3100, 1, b"HUGE").unwrap();
+    write(&mut d, 0x2002, 2, &(20_u32 << 20).to_le_bytes()).unwrap();
+    assert_eq!(write(&mut d, 0x2003, 2, &(20_u32 << 20).to_le_bytes()), Err(SdoAbort::DataTransfer));
+    drain(&mut d, 10 * MS);
+    assert!(d.status_leds().card_error, "CARD ERROR: the card is full");
+    // The other file is untouched and still logs.
+    write(&mut d, 0x5000, 8, &[0x33, 0x44]).unwrap();
+    remove_card(&mut d, 100 * MS);
+    let first = copy_out(&path, "FIRST.DAT");
+    assert_eq!(first.len(), 320);
+    assert_eq!(&first[9..11], &[0x33, 0x44]);
+    assert!(fsck_clean(&path), "a card that ran full is still clean");
+}
+
+#[test]
+fn the_status_leds_show_operational_and_card_access() {
+    let path = image("leds");
+    let mut d = device(&path);
+    configure(&mut d, 0, b"LEDS", 0x03, 0, false, 10);
+    drain(&mut d, MS);
+    let leds = d.status_leds();
+    assert!(leds.on && !leds.can && !leds.card_access && !leds.card_error && !leds.error, "{leds:?}");
+    operational(&mut d, 2 * MS);
+    d.on_frame(&CanFrame::data(0x200 + u16::from(NODE), &payload(1)).unwrap(), 3 * MS);
+    let leds = d.status_leds();
+    assert!(leds.can && leds.card_access, "logging: {leds:?}");
+    drain(&mut d, 60 * MS);
+    assert!(!d.status_leds().card_access, "a pulse per record");
+    assert_eq!(d.console("leds").unwrap(), "leds lit: on can");
+}

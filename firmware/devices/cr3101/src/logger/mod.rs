@@ -65,7 +65,7 @@ pub struct Logger<D: BlockDevice> {
     conditions: Conditions,
     /// When moved pointers are saved to the card.
     save_at_us: Option<u64>,
-    /// Card accesses that failed (a card pulled or broken mid-write, a card full).
+    /// Accesses to the card in the slot that failed (pulled or broken mid-write, full).
     pub card_errors: u32,
     /// Records written to the card.
     card_writes: u32,
@@ -161,6 +161,8 @@ impl<D: BlockDevice> Logger<D> {
             // The slot holds one card: the old one's device goes with the new one's refusal.
             drop(old);
         }
+        // CARD ERROR tells of this card's accesses.
+        self.card_errors = 0;
         let mut card = match Card::mount(device, FatClock) {
             Ok(card) => card,
             Err((_, device)) => {
@@ -192,9 +194,8 @@ impl<D: BlockDevice> Logger<D> {
         }
         let now = self.now_us;
         for n in 0..FILES {
-            if self.open_file(n, false).is_err() {
-                self.card_errors = self.card_errors.wrapping_add(1);
-            }
+            // A file that cannot be opened is counted, and its accesses refused.
+            let _ = self.open_file(n, false);
             if let (Some(run), Some(file)) = (self.runs.get_mut(n), settings.files.get(n)) {
                 *run = FileRun::new(file.layout());
                 run.restart(file, now);
@@ -269,11 +270,13 @@ impl<D: BlockDevice> Logger<D> {
         let name = core::str::from_utf8(name.get(..len).unwrap_or_default()).map_err(|_| CardError::Name)?;
         let protected = self.status.write_protected;
         let card = self.card.as_mut().ok_or(CardError::NoVolume)?;
-        match size {
+        let opened = match size {
             0 => card.close(n),
             _ if protected => card.open_read_only(n, name).map(|_| ()),
             _ => card.lay_out(n, name, size, erase),
-        }
+        };
+        // A card that is full or broken lights CARD ERROR.
+        opened.inspect_err(|_| self.card_errors = self.card_errors.wrapping_add(1))
     }
 
     /// Card data needs a card: without one, the access is refused and counted for EMCY 5001h.
