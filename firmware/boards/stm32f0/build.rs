@@ -1,7 +1,8 @@
 //! The STM32F042K6's memory map: 32 KiB of flash at 0x0800_0000, 6 KiB of SRAM. Built for
-//! another chip (feature `stm32f091`: this crate as the library of `firmware/boards/stm32f091`)
-//! it writes none: that crate's build script writes its chip's, and a second `memory.x` on the
-//! link search path would compete with it.
+//! another chip (feature `stm32f091` or `stm32f072`: this crate as the library of
+//! `firmware/boards/stm32f091` or `firmware/boards/stm32f072`) it writes none: that crate's
+//! build script writes its chip's, and a second `memory.x` on the link search path would
+//! compete with it.
 
 include!("../memory_x.rs");
 

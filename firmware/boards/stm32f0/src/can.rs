@@ -1,4 +1,5 @@
-//! bxCAN at 48 MHz: the bit timing of every CO401Memory1 bit rate, frame conversion to and from
+//! bxCAN at 48 MHz: the bit timing of every CO401Memory1 and CR3101 bit rate (1000, 800, 500,
+//! 250, 125, 100, 50, 20 and 10 kbit/s, all exact), frame conversion to and from
 //! the stack's [`CanFrame`], and the controller's error state.
 
 use coforge_stack::frame::CanFrame;
@@ -19,13 +20,14 @@ const fn btr(brp: u32, ts1: u32, ts2: u32) -> u32 {
 /// CiA 301's recommended point for every rate up to 1 Mbit/s; 800 kbit/s has 60 clocks per bit
 /// and uses 15 tq (1 + 12 + 2): 86.7 %.
 #[rustfmt::skip]
-const TIMINGS: [(u32, u32, u32, u32); 8] = [
+const TIMINGS: [(u32, u32, u32, u32); 9] = [
     // kbit/s, BRP, TS1, TS2      tq/bit  sample point  BTR
     (1000,   3, 13, 2),        // 16      87.5 %        0x011C_0002
     (800,    4, 12, 2),        // 15      86.7 %        0x011B_0003
     (500,    6, 13, 2),        // 16      87.5 %        0x011C_0005
     (250,   12, 13, 2),        // 16      87.5 %        0x011C_000B
     (125,   24, 13, 2),        // 16      87.5 %        0x011C_0017
+    (100,   30, 13, 2),        // 16      87.5 %        0x011C_001D
     (50,    60, 13, 2),        // 16      87.5 %        0x011C_003B
     (20,   150, 13, 2),        // 16      87.5 %        0x011C_0095
     (10,   300, 13, 2),        // 16      87.5 %        0x011C_012B
@@ -44,8 +46,8 @@ const _: () = {
     }
 };
 
-/// The BTR value for `kbit` (the BD pins' bit rates); 1 Mbit/s, the unconnected default, for
-/// anything else.
+/// The BTR value for `kbit` (the BD pins' bit rates, CR3101's 20F2h codes); 1 Mbit/s, the
+/// unconnected default, for anything else.
 pub fn bit_timing(kbit: u32) -> u32 {
     let (_, brp, ts1, ts2) = TIMINGS.iter().copied().find(|t| t.0 == kbit).unwrap_or(TIMINGS[0]);
     btr(brp, ts1, ts2)

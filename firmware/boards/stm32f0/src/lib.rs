@@ -65,10 +65,18 @@
 //! with the features `stm32f091` and `canopenia` for its image; this crate's `canopenia` is the
 //! STM32F042K6 image, which does not fit the chip yet (feature `canopenia-image`, pending in
 //! `dist`).
+//!
+//! # CR3101 on the STM32F072CB
+//!
+//! [`cr3101::run`] (feature `cr3101`) is the CR3101 CANmem image of
+//! `firmware/boards/stm32f072`, which builds this library with the features `stm32f072` and
+//! `cr3101`: the SD card on SPI1, the RTC, five status LEDs, the parameters in a 24C128 (pins
+//! in `firmware/boards/stm32f072/PINS.md`).
 #![no_std]
 // One read of a status register (`serve::esr`), the GW1 board's port registers (`gw1::Ports`),
 // the F091's configuration flash (`config_flash`: programming and reading it in place) and the
-// chip's unique ID (`coprocessor::serial_number`) are the only `unsafe`.
+// chip's unique ID (`coprocessor::serial_number`) and the RTC's calendar writes
+// (`cr3101::rtc`: registers svd2rust cannot range-check) are the only `unsafe`.
 #![deny(unsafe_code)]
 #![deny(clippy::indexing_slicing, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
 
@@ -79,6 +87,8 @@ pub mod clock;
 pub mod config_flash;
 #[cfg(feature = "canopenia")]
 pub mod coprocessor;
+#[cfg(feature = "cr3101")]
+pub mod cr3101;
 pub mod gw1;
 pub mod i2c;
 pub mod serve;

@@ -1,6 +1,7 @@
-//! The main loop, for any device: its serial host port (if it has one) on USART2, its CAN
-//! side on bxCAN, its CiA 303-3 indicators on two LEDs ([`Indicators`]: the loop's, or the
-//! device's own when it drives them through its board, as CO401GW1 does).
+//! The main loop, for any device: its serial host port (if it has one) on USART2 ([`NoHost`]
+//! for an image without one), its CAN side on bxCAN, its CiA 303-3 indicators on two LEDs
+//! ([`Indicators`]: the loop's, or the device's own when it drives them through its board, as
+//! CO401GW1 and CR3101 do).
 
 use crate::{can, clock};
 use coforge_stack::device::Device;
@@ -53,14 +54,65 @@ impl Indicators for OwnIndicators {
     fn show(&mut self, _: LedStates, _: u32) {}
 }
 
+/// No serial host line: a device without a host port (CR3101), whose image leaves USART2 and
+/// PA2/PA3 alone. Reads nothing, takes every byte.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoHost;
+
+impl Read<u8> for NoHost {
+    type Error = core::convert::Infallible;
+
+    fn read(&mut self) -> nb::Result<u8, Self::Error> {
+        Err(nb::Error::WouldBlock)
+    }
+}
+
+impl Write<u8> for NoHost {
+    type Error = core::convert::Infallible;
+
+    fn write(&mut self, _: u8) -> nb::Result<(), Self::Error> {
+        Ok(())
+    }
+
+    fn flush(&mut self) -> nb::Result<(), Self::Error> {
+        Ok(())
+    }
+}
+
 /// Starts the device and serves it for ever. `bxcan` comes disabled (off the bus) with its
 /// bit timing and filters set: it is enabled once the device's CAN side is
 /// active (`NodeAccess::can_enabled`: at once for most devices, after the host's enable
 /// command for CO401GW1). Not inlined: the device's handlers inlined here have frames of their own,
 /// which must not add to the frame that built the device.
 #[inline(never)]
-pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut indicators: impl Indicators) -> ! {
+pub fn serve<D: Device>(device: &mut D, host: Host, bxcan: Can, indicators: impl Indicators) -> ! {
     device.start(0);
+    serve_loop(device, host, bxcan, indicators, |_, _| {})
+}
+
+/// [`serve`] for a device its caller has already started (`Device::start(0)`), for a device
+/// whose start decides what the controller needs (CR3101's bit rate comes from its stored
+/// 20F2h/20F3h pair), over any serial host line (`NoHost` for none), with `each_pass` called
+/// at the end of every pass with the device and the loop's time in microseconds.
+#[inline(never)]
+pub fn serve_started<D: Device, H: Read<u8> + Write<u8>>(
+    device: &mut D,
+    host: H,
+    bxcan: Can,
+    indicators: impl Indicators,
+    each_pass: impl FnMut(&mut D, u64),
+) -> ! {
+    serve_loop(device, host, bxcan, indicators, each_pass)
+}
+
+#[inline(always)]
+fn serve_loop<D: Device, H: Read<u8> + Write<u8>>(
+    device: &mut D,
+    mut host: H,
+    mut bxcan: Can,
+    mut indicators: impl Indicators,
+    mut each_pass: impl FnMut(&mut D, u64),
+) -> ! {
     let mut on_bus = false;
     // A frame the mailboxes did not take (all three busy with frames of higher or equal
     // priority, or one bxcan took out to make room): sent before anything new is polled.
@@ -123,6 +175,7 @@ pub fn serve<D: Device>(device: &mut D, mut host: Host, mut bxcan: Can, mut indi
         }
 
         indicators.show(device.leds(), now_ms as u32);
+        each_pass(device, now_us);
     }
 }
 
