@@ -138,6 +138,17 @@ pub fn at_ms_since_2000(ms: u64) -> TimeStamp {
     of_ms(ms)
 }
 
+/// Milliseconds from 2000-01-01 00:00 to a valid `t` (a board's RTC compares with it).
+pub fn ms_since_2000(t: &TimeStamp) -> u64 {
+    to_ms(t)
+}
+
+/// The day of the week of a valid `t`, ISO 8601: 1 = Monday .. 7 = Sunday (2000-01-01 was a
+/// Saturday).
+pub fn weekday(t: &TimeStamp) -> u8 {
+    (days_since_2000(t.year, t.month, t.day).rem_euclid(7) as u8 + 5) % 7 + 1
+}
+
 fn of_ms(ms: u64) -> TimeStamp {
     let (year, month, day) = date_of((ms / MS_PER_DAY) as i64);
     let in_day = ms % MS_PER_DAY;
@@ -240,6 +251,14 @@ mod tests {
         assert_eq!(c.now(3_000_000), ts(26, 4, 30, 8, 0, 3, 0));
         assert_eq!(c.fat_time(3_000_000).year_since_1970, 56);
         assert_eq!((c.fat_time(3_000_000).zero_indexed_month, c.fat_time(3_000_000).zero_indexed_day), (3, 29));
+    }
+
+    #[test]
+    fn weekdays_follow_the_calendar() {
+        assert_eq!(weekday(&ts(0, 1, 1, 0, 0, 0, 0)), 6, "2000-01-01, a Saturday");
+        assert_eq!(weekday(&ts(26, 12, 3, 0, 0, 0, 0)), 4, "2026-12-03, a Thursday");
+        assert_eq!(weekday(&ts(28, 2, 29, 0, 0, 0, 0)), 2, "2028-02-29, a Tuesday");
+        assert_eq!(ms_since_2000(&ts(0, 1, 2, 0, 0, 1, 5)), MS_PER_DAY + 1005);
     }
 
     #[test]

@@ -18,6 +18,7 @@
 //! the prescalers are the 32.768 kHz values (PREDIV_A 127, PREDIV_S 255: 1 Hz).
 
 use cr3101::card::record::TimeStamp;
+use cr3101::clock::ms_since_2000;
 use stm32f0xx_hal::pac::{PWR, RCC, RTC};
 
 /// The clock when the calendar was never set: the RTC's own start, 2000-01-01 00:00.
@@ -30,7 +31,6 @@ pub const RETRY_MS: u32 = 60_000;
 /// Synchronous prescaler: 32,768 Hz / (127 + 1) / (255 + 1) = 1 Hz.
 const PREDIV_S: u32 = 255;
 const PREDIV_A: u32 = 127;
-const SECONDS_PER_DAY: u64 = 86_400;
 
 /// Switches on the PWR clock and backup-domain write access, and on a new backup domain the
 /// LSE as the RTC's clock. Before `clock::start_core`, which gives the RCC to the HAL (whose
@@ -73,7 +73,7 @@ impl Rtc {
     /// unreadable); `ms`: the loop's milliseconds (low 32 bits), for the retry delay.
     pub fn keep(&mut self, now: &TimeStamp, ms: u32) {
         let off = match self.read() {
-            Some(t) => seconds_since_2000(&t).abs_diff(seconds_since_2000(now)) > 1,
+            Some(t) => (ms_since_2000(&t) / 1000).abs_diff(ms_since_2000(now) / 1000) > 1,
             None => true,
         };
         if !off {
@@ -126,7 +126,7 @@ impl Rtc {
         let bcd = |v: u8| u32::from(v / 10) << 4 | u32::from(v % 10);
         let tr = bcd(t.hour) << 16 | bcd(t.minute) << 8 | bcd(t.second);
         // Day of the week, 1 = Monday .. 7 = Sunday: 2000-01-01 was a Saturday.
-        let weekday = (days_since_2000(t.year, t.month, t.day) + 5) % 7 + 1;
+        let weekday = u32::from(cr3101::clock::weekday(t));
         let dr = bcd(t.year) << 16 | weekday << 13 | bcd(t.month) << 8 | bcd(t.day);
         self.unlock(true);
         self.regs.isr.modify(|_, w| w.init().set_bit());
@@ -164,19 +164,3 @@ impl Rtc {
     }
 }
 
-/// Days from 2000-01-01 to a valid date (exact for 2000..2099, where every fourth year is a
-/// leap year, 2000 included).
-fn days_since_2000(year: u8, month: u8, day: u8) -> u32 {
-    const BEFORE_MONTH: [u16; 12] = [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334];
-    let y = u32::from(year);
-    let leap_day = u32::from(year.is_multiple_of(4) && month > 2);
-    let before = BEFORE_MONTH.get(usize::from(month.saturating_sub(1))).copied().unwrap_or(0);
-    y * 365 + y.div_ceil(4) + u32::from(before) + leap_day + u32::from(day) - 1
-}
-
-/// Seconds from 2000-01-01 00:00:00 to `t` (exact for 2000..2099; later years, which the
-/// calendar cannot hold, only need to differ from it).
-fn seconds_since_2000(t: &TimeStamp) -> u64 {
-    let days = u64::from(days_since_2000(t.year, t.month, t.day));
-    days * SECONDS_PER_DAY + u64::from(t.hour) * 3600 + u64::from(t.minute) * 60 + u64::from(t.second)
-}
