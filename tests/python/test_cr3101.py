@@ -1,16 +1,33 @@
-"""CR3101 end to end in the simulator, with python-canopen as the master and the card an image
-file (`coforge sim cr3101 --card FILE`): files configured over SDO, process data logged from
-RPDOs in real time, the card taken out and read with mtools record by record (time stamps
-included, against the host's clock), `fsck.fat -n` clean; presets put on the card by mtools
-read back over SDO and through the PDO read mode; a card pulled while logging and no card.
+"""CR3101 end to end, with python-canopen as the master, against two targets that run the same
+device code:
+- `sim`: `coforge sim cr3101`, the card an image file (`--card FILE`), the clock the host's;
+- `qemu`: the Cortex-M3 image (lm3s6965evb, built by `cargo xtask dist`, path in
+  COFORGE_CR3101_QEMU_IMAGE) run in the test's own directory (where it keeps its parameter
+  file `cr3101.params`), the card image QEMU's SD card (`-drive if=sd`), taken out and put
+  back through the QEMU monitor (`eject -f sd0`, `change sd0 FILE raw`); UART1 is its SLCAN
+  adapter, which `coforge hub --connect` puts on a hub python-canopen joins. Its clock starts
+  at a fixed date (the board has no RTC), so its time stamps are compared with the host's
+  clock relative to the first record.
+
+Files configured over SDO, process data logged from RPDOs in real time, the card taken out and
+read with mtools record by record (time stamps included), `fsck.fat -n` clean; presets put on
+the card by mtools read back over SDO and through the PDO read mode; a card pulled while
+logging and no card. For the image only: the power cut (QEMU killed) while it logs, at several
+points: the card stays clean and every record the device reported written reads back. A
+write-protected card is not tried on the image: QEMU's SPI-mode SD card has no write-protect
+switch, and QEMU refuses a read-only drive as an SD card.
 """
 
 import datetime
 import os
 import pathlib
+import re
 import shutil
+import socket
 import struct
 import subprocess
+import tempfile
+import threading
 import time
 
 import canopen
@@ -18,24 +35,135 @@ import pytest
 
 from bus import Recorder
 from simproc import SimProcess
+from test_e2e_memory1 import free_port
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
+# Absolute: QEMU runs in a test's own directory, where it keeps the parameter file.
+IMAGE = str(pathlib.Path(os.environ.get("COFORGE_CR3101_QEMU_IMAGE", ROOT / "target" / "dist" / "images" / "cr3101-qemu.bin")).resolve())
 MTOOLS = dict(os.environ, MTOOLS_SKIP_CHECK="1")
+KINDS = ["sim", "qemu"]
 NODE = 0x20
 # Component 1 WORD, 2 DINT, 4 BYTE: 9 + 2 + 4 + 1 = 16-byte records.
 RELEVANT, RECORD = 0b1011, 16
+# Records of the power-cut test's file, and frames its sender sends at most (one each 2 ms).
+FRAMES = 1000
+
+
+class QemuCr3101:
+    """The image in QEMU, run in `workdir`, with the card image `card` in its SD slot: UART0
+    unused, UART1 (SLCAN) on a `coforge hub` (`can_url`), UART2 its console, the monitor on a
+    TCP port."""
+
+    def __init__(self, workdir, card):
+        assert pathlib.Path(IMAGE).exists(), f"no QEMU image at {IMAGE}: run `cargo xtask dist`"
+        self.ports = [free_port() for _ in range(4)]
+        uarts = self.ports[:3]
+        self.output = tempfile.TemporaryFile()
+        self.hub = self.monitor_sock = self.console_sock = None
+        self.cut = False
+        self.qemu = subprocess.Popen(
+            ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic",
+             "-monitor", f"tcp:127.0.0.1:{self.ports[3]},server=on,wait=off",
+             "-semihosting-config", "enable=on,target=native", "-kernel", IMAGE,
+             "-drive", f"if=sd,format=raw,file={card}",
+             *(arg for port in uarts for arg in ("-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"))],
+            stdin=subprocess.DEVNULL, stdout=self.output, stderr=subprocess.STDOUT, cwd=workdir,
+        )
+        try:
+            self.hub = subprocess.Popen([COFORGE, "hub", "--port", "0", "--connect", f"127.0.0.1:{uarts[1]}"], stdout=subprocess.PIPE, text=True)
+            hub = re.search(r"on slcan (socket://\S+)", self.hub.stdout.readline())
+            assert hub, f"coforge hub banner{self.output_note()}"
+            self.can_url = hub.group(1)
+        except BaseException:
+            self.stop()
+            raise
+
+    def _connect(self, port, timeout=10.0):
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                return socket.create_connection(("127.0.0.1", port), timeout=5.0)
+            except OSError:
+                assert time.monotonic() < deadline, f"QEMU does not listen on port {port}{self.output_note()}"
+                time.sleep(0.05)
+
+    def _until(self, sock, done, timeout=10.0):
+        """What `sock` sends until `done(text so far)`."""
+        data = b""
+        deadline = time.monotonic() + timeout
+        while not done(data):
+            assert time.monotonic() < deadline, f"no answer; got {data!r}"
+            sock.settimeout(max(deadline - time.monotonic(), 0.01))
+            more = sock.recv(4096)
+            assert more, f"connection closed; got {data!r}{self.output_note()}"
+            data += more
+        return data
+
+    def monitor(self, command):
+        """Runs a QEMU monitor command; returns what it printed (its echo line removed)."""
+        def prompt(d):
+            return d.endswith(b"(qemu) ")
+
+        if self.monitor_sock is None:
+            self.monitor_sock = self._connect(self.ports[3])
+            self._until(self.monitor_sock, prompt)
+        self.monitor_sock.sendall(command.encode() + b"\n")
+        out = self._until(self.monitor_sock, lambda d: b"\r\n" in d and prompt(d))
+        return out.split(b"\r\n", 1)[1][: -len(b"(qemu) ")].decode(errors="replace").strip()
+
+    def console(self, command):
+        """Runs a console command on UART2; returns the text after 'ok '."""
+        if self.console_sock is None:
+            self.console_sock = self._connect(self.ports[2])
+        self.console_sock.sendall(command.encode() + b"\n")
+        line = self._until(self.console_sock, lambda d: d.endswith(b"\n")).decode().strip()
+        assert line.startswith("ok "), f"console {command!r}: {line!r}"
+        return line[len("ok ") :]
+
+    def output_note(self):
+        self.output.seek(0)
+        text = self.output.read().decode(errors="replace")
+        return f"; QEMU printed: {text}" if text else ""
+
+    def power_cut(self):
+        """QEMU killed: nothing is closed or flushed."""
+        self.cut = True
+        self.qemu.kill()
+        self.qemu.wait(timeout=10)
+
+    def stop(self):
+        """Stops QEMU and the hub; fails if QEMU had exited by itself (a panic), with its output."""
+        exited = None if self.cut else self.qemu.poll()
+        for sock in (self.monitor_sock, self.console_sock):
+            if sock is not None:
+                sock.close()
+        for proc in (self.hub, self.qemu):
+            if proc is not None:
+                proc.kill()
+                proc.wait(timeout=10)
+        if self.hub is not None:
+            self.hub.stdout.close()
+        note = self.output_note()
+        self.output.close()
+        assert exited is None, f"QEMU exited by itself with {exited}{note}"
 
 
 class Logger:
-    """A running CR3101 with its card image, and python-canopen on its bus."""
+    """A running CR3101 (`kind` "sim" or "qemu") with its card image, and python-canopen on its
+    bus."""
 
-    def __init__(self, workdir, card, store=True):
-        keep = ["--store", str(pathlib.Path(workdir) / "cr3101.params")] if store else []
-        self.sim = SimProcess([COFORGE, "sim", "cr3101", "--node-id", str(NODE), "--port", "0", "--card", str(card), *keep])
+    def __init__(self, workdir, card, kind="sim", store=True):
+        self.kind, self.card = kind, card
+        if kind == "sim":
+            keep = ["--store", str(pathlib.Path(workdir) / "cr3101.params")] if store else []
+            self.sim = SimProcess([COFORGE, "sim", "cr3101", "--node-id", str(NODE), "--port", "0", "--card", str(card), *keep])
+        else:
+            # The image keeps its parameters in its working directory whatever `store` says.
+            self.sim = QemuCr3101(workdir, card)
         self.net = None
         try:
-            url = self.sim.banner(rf"cr3101 node-ID {NODE} on slcan (socket://\S+)")
+            url = self.sim.banner(rf"cr3101 node-ID {NODE} on slcan (socket://\S+)") if kind == "sim" else self.sim.can_url
             self.net = canopen.Network()
             self.rec = Recorder()
             self.net.listeners.insert(0, self.rec)
@@ -43,9 +171,41 @@ class Logger:
             self.node = canopen.RemoteNode(NODE, canopen.ObjectDictionary())
             self.node.sdo.RESPONSE_TIMEOUT = 2.0
             self.net.add_node(self.node)
+            if kind == "qemu":
+                self.ready()
         except BaseException:
             self.close()
             raise
+
+    def ready(self, timeout=20.0):
+        """Until the node answers an SDO read of 1000h (an image in QEMU starts slowly: it
+        mounts the card before its loop runs)."""
+        deadline = time.monotonic() + timeout
+        self.node.sdo.RESPONSE_TIMEOUT = 0.5
+        try:
+            while True:
+                try:
+                    self.node.sdo.upload(0x1000, 0)
+                    return
+                except canopen.SdoCommunicationError:
+                    assert time.monotonic() < deadline, f"the image does not answer SDO{self.sim.output_note()}"
+        finally:
+            self.node.sdo.RESPONSE_TIMEOUT = 2.0
+
+    def pull_card(self):
+        """The card taken out of the slot (the device sees it at its next poll)."""
+        if self.kind == "sim":
+            self.sim.console("card remove")
+        else:
+            out = self.sim.monitor("eject -f sd0")
+            assert not out, out
+
+    def put_back_card(self):
+        if self.kind == "sim":
+            self.sim.console("card insert")
+        else:
+            out = self.sim.monitor(f"change sd0 {self.card} raw")
+            assert not out, out
 
     def write(self, index, sub, value, fmt=None):
         data = value if isinstance(value, bytes) else struct.pack(fmt, value)
@@ -101,20 +261,25 @@ def fsck_clean(card, tmp_path):
     return fsck.returncode == 0, fsck.stdout + fsck.stderr
 
 
+# The image's clock at power-on.
+POWER_ON = datetime.datetime(2026, 1, 1, tzinfo=datetime.timezone.utc)
+
+
 def stamp_of(record):
     ms, s, mi, h, d, mo, y = struct.unpack("<HBBBBBB", record[:8])
     return datetime.datetime(2000 + y, mo, d, h, mi, s, ms * 1000, tzinfo=datetime.timezone.utc)
 
 
 def remove_card(dev):
-    dev.sim.console("card remove")
+    dev.pull_card()
     time.sleep(0.3)  # the slot is polled every 100 ms
     assert dev.read(0x2001, 1) == b"\x00"
 
 
-def test_a_logging_session_reads_back_record_by_record_with_mtools(tmp_path):
+@pytest.mark.parametrize("kind", KINDS)
+def test_a_logging_session_reads_back_record_by_record_with_mtools(tmp_path, kind):
     card = new_card(tmp_path)
-    dev = Logger(tmp_path, card)
+    dev = Logger(tmp_path, card, kind)
     try:
         dev.configure(0, b"OIL_TEMP", 0x03, 0, 200)
         dev.node.nmt.state = "OPERATIONAL"
@@ -126,6 +291,7 @@ def test_a_logging_session_reads_back_record_by_record_with_mtools(tmp_path):
         time.sleep(0.2)
         assert dev.read(0x3005, 0, "<I") == 100, "one record per frame (window 0)"
         assert dev.read(0x5000, 9, "<i") == -99_000, "5000h shows the last record, its DINT in 4 bytes"
+        assert {"on", "can"} <= set(dev.sim.console("leds").split()[2:]), "ON and CAN (operational) lit"
         remove_card(dev)
     finally:
         dev.close()
@@ -134,12 +300,20 @@ def test_a_logging_session_reads_back_record_by_record_with_mtools(tmp_path):
     data = copy_out(card, tmp_path, "OIL_TEMP.DAT")
     assert len(data) == 200 * RECORD
     previous = None
+    # The simulator's clock is the host's; the image's starts at 2026-01-01 00:00 at power-on
+    # (no RTC): its stamps are compared with the host's clock from the first record on.
+    first = stamp_of(data[:RECORD])
+    if kind == "qemu":
+        assert POWER_ON <= first < POWER_ON + datetime.timedelta(minutes=1), f"record 0 stamped {first}"
     for n in range(100):
         record = data[n * RECORD : (n + 1) * RECORD]
         assert record[8] == RELEVANT, f"record {n}: every component written"
         assert record[9:] == values(n), f"record {n}"
         t = stamp_of(record)
-        assert abs((t - sent[n]).total_seconds()) < 0.25, f"record {n} stamped {t}, sent {sent[n]}"
+        if kind == "sim":
+            assert abs((t - sent[n]).total_seconds()) < 0.25, f"record {n} stamped {t}, sent {sent[n]}"
+        else:
+            assert abs(((t - first) - (sent[n] - sent[0])).total_seconds()) < 0.25, f"record {n} stamped {t}, sent {sent[n] - sent[0]} after record 0"
         assert previous is None or t >= previous
         previous = t
     assert data[100 * RECORD :] == bytes(100 * RECORD), "the rest of the file still zeros"
@@ -147,9 +321,10 @@ def test_a_logging_session_reads_back_record_by_record_with_mtools(tmp_path):
     assert clean, report
 
 
-def test_presets_put_on_the_card_by_a_pc_read_back_over_sdo_and_the_pdo_read_mode(tmp_path):
+@pytest.mark.parametrize("kind", KINDS)
+def test_presets_put_on_the_card_by_a_pc_read_back_over_sdo_and_the_pdo_read_mode(tmp_path, kind):
     card = new_card(tmp_path)
-    dev = Logger(tmp_path, card)
+    dev = Logger(tmp_path, card, kind)
     try:
         dev.configure(1, b"PRESETS", 0x10, 1, 4)
         remove_card(dev)
@@ -161,7 +336,7 @@ def test_presets_put_on_the_card_by_a_pc_read_back_over_sdo_and_the_pdo_read_mod
     presets.write_bytes(table)
     subprocess.run(["mcopy", "-o", "-i", f"{card}@@1M", presets, "::PRESETS.DAT"], env=MTOOLS, check=True)
 
-    dev = Logger(tmp_path, card)
+    dev = Logger(tmp_path, card, kind)
     try:
         dev.write(0x3104, 0, 2, "<I")
         assert dev.read(0x5100, 1, "<H") == 102, "the time stamp's milliseconds"
@@ -169,8 +344,9 @@ def test_presets_put_on_the_card_by_a_pc_read_back_over_sdo_and_the_pdo_read_mod
         dev.write(0x20F5, 0, 1, "<B")
     finally:
         dev.close()
-    # PDO read mode from the next power-on (20F5h is kept in --store).
-    dev = Logger(tmp_path, card)
+    # PDO read mode from the next power-on (20F5h is kept in --store, or the image's
+    # parameter file in the test's directory).
+    dev = Logger(tmp_path, card, kind)
     try:
         dev.node.nmt.state = "OPERATIONAL"
         time.sleep(0.1)
@@ -188,9 +364,10 @@ def test_presets_put_on_the_card_by_a_pc_read_back_over_sdo_and_the_pdo_read_mod
     assert clean, report
 
 
-def test_a_card_pulled_while_logging_and_put_back(tmp_path):
+@pytest.mark.parametrize("kind", KINDS)
+def test_a_card_pulled_while_logging_and_put_back(tmp_path, kind):
     card = new_card(tmp_path)
-    dev = Logger(tmp_path, card)
+    dev = Logger(tmp_path, card, kind)
     try:
         dev.configure(0, b"PULLED", 0x03, 0, 100)
         dev.node.nmt.state = "OPERATIONAL"
@@ -198,7 +375,7 @@ def test_a_card_pulled_while_logging_and_put_back(tmp_path):
             dev.net.send_message(0x200 + NODE, values(n))
             time.sleep(0.01)
         time.sleep(0.1)
-        dev.sim.console("card remove")
+        dev.pull_card()
         time.sleep(0.3)
         mark = dev.rec.mark()
         dev.net.send_message(0x200 + NODE, values(99))
@@ -208,7 +385,7 @@ def test_a_card_pulled_while_logging_and_put_back(tmp_path):
             dev.read(0x3004, 0)
         assert refused.value.code == 0x0800_0020
         mark = dev.rec.mark()
-        dev.sim.console("card insert")
+        dev.put_back_card()
         reset = dev.rec.wait(0x80 + NODE, mark, 2.0)
         assert reset and bytes(reset.data) == bytes(8), "the card is back: error reset"
         for n in range(10, 20):
@@ -221,5 +398,69 @@ def test_a_card_pulled_while_logging_and_put_back(tmp_path):
         dev.close()
     data = copy_out(card, tmp_path, "PULLED.DAT")
     assert [data[n * RECORD + 9 :][: RECORD - 9] for n in range(20)] == [values(n) for n in range(20)]
+    clean, report = fsck_clean(card, tmp_path)
+    assert clean, report
+
+
+# 600: after the pointers' delayed save to CANMEM.CFG (1 s after the first record).
+@pytest.mark.parametrize("cut_after", [0, 37, 120, 600])
+def test_a_power_cut_while_logging_leaves_the_card_clean_and_every_record_written(tmp_path, cut_after):
+    """The image only (a power cut is QEMU killed): frames keep coming while QEMU is killed,
+    just after the device said over SDO how many records it had written (3005h) once
+    `cut_after` frames were sent. The card is `fsck.fat` clean, every record reported written
+    reads back byte for byte, what came after them is whole records or nothing, and at the
+    next power-on the device finds every record on the card."""
+    card = new_card(tmp_path)
+    dev = Logger(tmp_path, card, "qemu")
+    stop, sent = threading.Event(), []
+
+    def send():
+        for n in range(FRAMES):
+            if stop.is_set():
+                return
+            dev.net.send_message(0x200 + NODE, values(n))
+            sent.append(n)
+            time.sleep(0.002)
+
+    sender = threading.Thread(target=send, daemon=True)
+    try:
+        dev.configure(0, b"CUT", 0x03, 0, FRAMES)
+        dev.node.nmt.state = "OPERATIONAL"
+        time.sleep(0.1)
+        sender.start()
+        deadline = time.monotonic() + 10
+        while len(sent) < cut_after:
+            assert time.monotonic() < deadline, "the frames do not go out"
+            time.sleep(0.001)
+        written = dev.read(0x3005, 0, "<I")
+        dev.sim.power_cut()
+        stop.set()
+        sender.join(timeout=5)
+    finally:
+        stop.set()
+        dev.close()
+    assert written <= len(sent)
+    clean, report = fsck_clean(card, tmp_path)
+    assert clean, report
+    data = copy_out(card, tmp_path, "CUT.DAT")
+    assert len(data) == FRAMES * RECORD, "the file keeps its pre-allocated size"
+    records = [data[n * RECORD : (n + 1) * RECORD] for n in range(FRAMES)]
+    for n in range(written):
+        assert records[n][8] == RELEVANT and records[n][9:] == values(n), f"record {n}, reported written, reads back"
+    stamps = [stamp_of(r) for r in records[:written]]
+    assert stamps == sorted(stamps), "time stamps in order"
+    # What came after the SDO answer: whole records, then nothing (a block is written whole).
+    intact = written
+    while intact < FRAMES and records[intact][8] == RELEVANT and records[intact][9:] == values(intact):
+        intact += 1
+    assert all(r == bytes(RECORD) for r in records[intact:]), f"records {intact}.. are empty"
+    print(f"power cut after {len(sent)} frames: {written} records reported written, {intact} on the card")
+
+    # Power again: logging goes on after the last record on the card (CR-48).
+    dev = Logger(tmp_path, card, "qemu")
+    try:
+        assert dev.read(0x3005, 0, "<I") == intact, "the records on the card are found again"
+    finally:
+        dev.close()
     clean, report = fsck_clean(card, tmp_path)
     assert clean, report

@@ -24,17 +24,22 @@ pub struct Bench {
     /// The device (and the prefix of its image names in `dist`).
     pub device: &'static str,
     title: &'static str,
+    /// It runs with QEMU's SD card: a blank card image it formats itself ([`card_args`]).
+    card: bool,
 }
 
 pub const BENCHES: &[Bench] = &[
-    Bench { image: "bench-memory1", device: "co401memory1", title: "CO401Memory1" },
-    Bench { image: "bench-gw1", device: "co401gw1", title: "CO401GW1" },
+    Bench { image: "bench-memory1", device: "co401memory1", title: "CO401Memory1", card: false },
+    Bench { image: "bench-gw1", device: "co401gw1", title: "CO401GW1", card: false },
     // Not a device: the manager of coforge-stack, which CANopenIA runs.
-    Bench { image: "bench-manager", device: "manager", title: "coforge-stack manager (127 nodes monitored, 31 scans cached)" },
-    Bench { image: "bench-canopenia", device: "canopenia", title: "CANopenIA (remote access, 8 scans cached)" },
+    Bench { image: "bench-manager", device: "manager", title: "coforge-stack manager (127 nodes monitored, 31 scans cached)", card: false },
+    Bench { image: "bench-canopenia", device: "canopenia", title: "CANopenIA (remote access, 8 scans cached)", card: false },
     // Not an image of its own: CANopenIA's start with a loaded configuration file.
-    Bench { image: "bench-canopenia-config", device: "canopenia-config", title: "CANopenIA with the vendor's CiA 401 file loaded" },
+    Bench { image: "bench-canopenia-config", device: "canopenia-config", title: "CANopenIA with the vendor's CiA 401 file loaded", card: false },
+    Bench { image: "bench-cr3101", device: "cr3101", title: "CR3101 (QEMU's SD card, FAT16)", card: true },
 ];
+/// The blank card a bench image with `card` gets: QEMU's SD card needs a power of two.
+const CARD_BYTES: u64 = 16 << 20;
 /// A run takes well under a second; this only stops a hung image.
 const QEMU_TIMEOUT: Duration = Duration::from_secs(120);
 /// The aims: instructions per expedited SDO request and per RPDO.
@@ -115,6 +120,19 @@ fn qemu(elf: &Path, extra: &[String]) -> Result<QemuRun> {
     Ok(QemuRun { code: status.code(), stdout: out.join().unwrap_or_default(), stderr: err.join().unwrap_or_default() })
 }
 
+/// QEMU's arguments for `bench`'s card, if it has one: a new blank (all zeros, sparse) card
+/// image in `target/bench`.
+fn card_args(bench: &Bench) -> Result<Vec<String>> {
+    if !bench.card {
+        return Ok(Vec::new());
+    }
+    std::fs::create_dir_all(out_dir()).map_err(|e| format!("cannot create {}: {e}", out_dir().display()))?;
+    let card = out_dir().join(format!("{}-card.img", bench.image));
+    let file = std::fs::File::create(&card).map_err(|e| format!("cannot create {}: {e}", card.display()))?;
+    file.set_len(CARD_BYTES).map_err(|e| format!("cannot size {}: {e}", card.display()))?;
+    Ok(vec!["-drive".into(), format!("if=sd,format=raw,file={}", card.display())])
+}
+
 /// Fails unless the image exited through semihosting with code 0.
 fn check_exit(r: &QemuRun) -> Result {
     if r.code == Some(0) {
@@ -128,7 +146,7 @@ fn check_exit(r: &QemuRun) -> Result {
 pub fn selftest() -> Result<Vec<(&'static str, u64)>> {
     let mut peaks = Vec::new();
     for (bench, elf) in BENCHES.iter().zip(build_images()?) {
-        let r = qemu(&elf, &[])?;
+        let r = qemu(&elf, &card_args(bench)?)?;
         check_exit(&r)?;
         let scenarios = r.stdout.lines().filter(|l| l.starts_with("bench ")).count();
         let peak = r
@@ -334,7 +352,9 @@ fn instructions() -> Result<String> {
         let marker = |name: &str| crate::elf::symbol(&bytes, name).map_err(|e| format!("{}: {e}", elf.display()));
         let (begin, end) = (marker("bench_begin")?, marker("bench_end")?);
         let plugin_arg = format!("{},begin={begin:#x},end={end:#x}", plugin.display());
-        let r = qemu(&elf, &["-d".into(), "plugin".into(), "-plugin".into(), plugin_arg])?;
+        let mut args = card_args(bench)?;
+        args.extend(["-d".into(), "plugin".into(), "-plugin".into(), plugin_arg]);
+        let r = qemu(&elf, &args)?;
         check_exit(&r)?;
         let counts = parse(&r.stdout, &r.stderr).map_err(|e| format!("{}: {e}", bench.image))?;
         md.push_str(&format!(

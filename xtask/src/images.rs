@@ -18,16 +18,16 @@ pub struct Board {
     pub ram: (u32, u32),
 }
 
-pub const BOARDS: &[Board] = &[QEMU, STM32F0, STM32F091];
+pub const BOARDS: &[Board] = &[QEMU, STM32F0, STM32F091, STM32F072];
 
 /// QEMU's lm3s6965evb (`firmware/boards/qemu`): 256 KiB of flash, 64 KiB of RAM.
 /// `co401memory1-files` is the same module with its banks in host files (semihosting);
 /// `co401gw1` keeps its parameters in a host file too, and has a pin console on UART2;
-/// `canopenia` keeps its parameters in a host file.
+/// `canopenia` keeps its parameters in a host file; `cr3101` too, its card QEMU's SD card.
 const QEMU: Board = Board {
     name: "qemu",
     target: "thumbv7m-none-eabi",
-    devices: &["co401memory1", "co401memory1-files", "co401gw1", "canopenia"],
+    devices: &["co401memory1", "co401memory1-files", "co401gw1", "canopenia", "cr3101"],
     features: &[],
     flash: (0, 256 * 1024),
     ram: (0x2000_0000, 64 * 1024),
@@ -61,6 +61,10 @@ const STM32F0_CANOPENIA: Board = Board { devices: &["canopenia"], features: &["c
 /// this chip, the same Cortex-M0 target): 256 KiB of flash, of which the image has the first
 /// 240 KiB (the last 16 KiB are CANopenIA's configuration files), and 32 KiB of RAM.
 const STM32F091: Board = Board { name: "stm32f091", devices: &["canopenia"], flash: (0x0800_0000, 240 * 1024), ram: (0x2000_0000, 32 * 1024), ..STM32F0 };
+
+/// The STM32F072CB board (`firmware/boards/stm32f072`, the board code of `stm32f0` built for
+/// this chip with its CR3101 board: SD card on SPI1, RTC): 128 KiB of flash, 16 KiB of RAM.
+const STM32F072: Board = Board { name: "stm32f072", devices: &["cr3101"], flash: (0x0800_0000, 128 * 1024), ram: (0x2000_0000, 16 * 1024), ..STM32F0 };
 
 /// The ELF an image build leaves in the board crate's target directory.
 pub(crate) fn built_elf(board: &Board, device: &str) -> PathBuf {
@@ -309,7 +313,7 @@ mod tests {
     }
 
     /// Every image `cargo xtask dist` built (the suite builds them before), on every board:
-    /// the QEMU lm3s6965, the STM32F042K6 and the STM32F091RC.
+    /// the QEMU lm3s6965, the STM32F042K6, the STM32F091RC and the STM32F072CB.
     #[test]
     fn every_built_image_fits_its_chips_memory_map() {
         for board in super::BOARDS {
@@ -337,6 +341,7 @@ mod tests {
         assert!(super::chip_of("qemu").unwrap_err().contains("QEMU"));
         assert_eq!(super::chip_of("stm32f0"), Ok("STM32F042K6Tx"));
         assert_eq!(super::chip_of("stm32f091"), Ok("STM32F091RCTx"));
+        assert_eq!(super::chip_of("stm32f072"), Ok("STM32F072CBTx"));
         let nope = super::chip_of("nope").unwrap_err();
         assert!(nope.contains("stm32f0, stm32f091"), "{nope}");
         assert!(super::chip_of("nope").unwrap_err().contains("--chip"));
@@ -382,6 +387,7 @@ pub fn chip_of(board: &str) -> std::result::Result<&'static str, String> {
         "qemu" => Err("the qemu board's images run in QEMU, not on a probe: see \"Running an image in QEMU\" in README.md".into()),
         "stm32f0" => Ok("STM32F042K6Tx"),
         "stm32f091" => Ok("STM32F091RCTx"),
+        "stm32f072" => Ok("STM32F072CBTx"),
         other => {
             let known: Vec<&str> = BOARDS.iter().map(|b| b.name).collect();
             Err(format!("no board `{other}` to flash (boards: {}); pass --chip to flash an image of your own board", known.join(", ")))

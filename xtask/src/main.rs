@@ -158,7 +158,8 @@ fn test() -> Result {
     let qemu_image = root().join("target/dist/images/co401memory1-qemu.bin");
     let gw1_qemu_image = root().join("target/dist/images/co401gw1-qemu.bin");
     let ia_qemu_image = root().join("target/dist/images/canopenia-qemu.bin");
-    // CR3101's card layer on QEMU's SD card: a test fixture until the device's image exists.
+    let cr3101_qemu_image = root().join("target/dist/images/cr3101-qemu.bin");
+    // CR3101's card layer alone on QEMU's SD card (a fixture; the device's image is in dist).
     let qemu_board = root().join("firmware/boards/qemu");
     run(cargo().args(["build", "--quiet", "--release", "--target", "thumbv7m-none-eabi", "--bin", "cr3101-card"]).current_dir(&qemu_board))?;
     let card_qemu_image = qemu_board.join("target/thumbv7m-none-eabi/release/cr3101-card");
@@ -168,6 +169,7 @@ fn test() -> Result {
         .env("COFORGE_QEMU_IMAGE", &qemu_image)
         .env("COFORGE_GW1_QEMU_IMAGE", &gw1_qemu_image)
         .env("COFORGE_IA_QEMU_IMAGE", &ia_qemu_image)
+        .env("COFORGE_CR3101_QEMU_IMAGE", &cr3101_qemu_image)
         .env("COFORGE_CARD_QEMU_IMAGE", &card_qemu_image)
         .current_dir(root())
         .status()
