@@ -56,47 +56,112 @@ impl Settings {
         }
     }
 
+    /// The file's bytes as pieces in order, `(offset, bytes)`, the CRC last: a writer copies
+    /// them into whatever buffer it has (a block at a time on a card), so the whole file is
+    /// never on the stack.
+    pub fn pieces(&self, mut piece: impl FnMut(usize, &[u8])) {
+        let mut crc = CCITT.start();
+        let mut put = |at: usize, bytes: &[u8]| {
+            crc = CCITT.update(crc, bytes);
+            piece(at, bytes);
+        };
+        let mut header = [0; FILES_AT];
+        header.iter_mut().zip(MAGIC.iter().chain(&[VERSION])).for_each(|(d, s)| *d = *s);
+        header.iter_mut().skip(5).zip(self.name.as_bytes()).for_each(|(d, s)| *d = *s);
+        for (n, size) in self.allocation.iter().enumerate() {
+            header.iter_mut().skip(16 + 4 * n).zip(size.to_le_bytes()).for_each(|(d, s)| *d = s);
+        }
+        put(0, &header);
+        for (n, file) in self.files.iter().enumerate() {
+            put(FILES_AT + n * ENCODED_LEN, &file.encode());
+        }
+        put(SAVED_AT, &self.saved_at.encode());
+        let crc = CCITT.finish(crc);
+        piece(CRC_AT, &crc.to_le_bytes());
+    }
+
+    /// Back to [`Settings::factory`], in place (the settings are a kilobyte: a device resets
+    /// them without a copy on its stack).
+    pub fn reset(&mut self) {
+        self.name = Text::new(b"00000000000").unwrap_or_default();
+        self.allocation = [0; FILES];
+        for (n, file) in self.files.iter_mut().enumerate() {
+            *file = FileConfig::factory(n);
+        }
+        self.saved_at = TimeStamp::default();
+    }
+
+    /// The whole file (tests, tools).
     pub fn encode(&self) -> [u8; LEN] {
-        fn put(out: &mut [u8; LEN], at: usize, bytes: &[u8]) {
+        let mut out = [0; LEN];
+        self.pieces(|at, bytes| {
             if let Some(dst) = out.get_mut(at..at + bytes.len()) {
                 dst.copy_from_slice(bytes);
             }
-        }
-        let mut out = [0; LEN];
-        put(&mut out, 0, &MAGIC);
-        put(&mut out, 4, &[VERSION]);
-        put(&mut out, 5, self.name.as_bytes());
-        for (n, size) in self.allocation.iter().enumerate() {
-            put(&mut out, 16 + 4 * n, &size.to_le_bytes());
-        }
-        for (n, file) in self.files.iter().enumerate() {
-            put(&mut out, FILES_AT + n * ENCODED_LEN, &file.encode());
-        }
-        put(&mut out, SAVED_AT, &self.saved_at.encode());
-        let crc = CCITT.checksum(out.get(..CRC_AT).unwrap_or_default());
-        put(&mut out, CRC_AT, &crc.to_le_bytes());
+        });
         out
     }
 
-    /// The settings of a configuration file; `None` for a file this format cannot take (another
-    /// version, a bad CRC, a field no write could have stored).
+    /// Reads a configuration file into `self` through `read(offset, buf)` (a piece at a time);
+    /// `false` for a file this format cannot take (another version, a bad CRC, a field no
+    /// write could have stored, a read that failed), and then `self` holds the factory
+    /// settings.
+    pub fn read_from(&mut self, mut read: impl FnMut(usize, &mut [u8]) -> bool) -> bool {
+        let ok = self.try_read(&mut read);
+        if !ok {
+            self.reset();
+        }
+        ok
+    }
+
+    fn try_read(&mut self, read: &mut impl FnMut(usize, &mut [u8]) -> bool) -> bool {
+        let mut crc = CCITT.start();
+        let mut take = |at: usize, buf: &mut [u8]| {
+            let ok = read(at, buf);
+            crc = CCITT.update(crc, buf);
+            ok
+        };
+        let mut header = [0; FILES_AT];
+        if !take(0, &mut header) || header.get(..4) != Some(&MAGIC[..]) || header.get(4) != Some(&VERSION) {
+            return false;
+        }
+        let Some(name) = header.get(5..16).and_then(Text::new) else { return false };
+        self.name = name;
+        for (n, size) in self.allocation.iter_mut().enumerate() {
+            let mut b = [0; 4];
+            b.iter_mut().zip(header.iter().skip(16 + 4 * n)).for_each(|(d, s)| *d = *s);
+            *size = u32::from_le_bytes(b);
+        }
+        for (n, file) in self.files.iter_mut().enumerate() {
+            let mut bytes = [0; ENCODED_LEN];
+            if !take(FILES_AT + n * ENCODED_LEN, &mut bytes) {
+                return false;
+            }
+            let Some(decoded) = FileConfig::decode(&bytes) else { return false };
+            *file = decoded;
+        }
+        let mut saved_at = [0; TIME_STAMP];
+        if !take(SAVED_AT, &mut saved_at) {
+            return false;
+        }
+        self.saved_at = TimeStamp::decode(&saved_at);
+        let computed = CCITT.finish(crc);
+        let mut stored = [0; 2];
+        read(CRC_AT, &mut stored) && u16::from_le_bytes(stored) == computed
+    }
+
+    /// The settings of a whole configuration file (tests, tools); `None` for a file this
+    /// format cannot take.
     pub fn decode(bytes: &[u8; LEN]) -> Option<Settings> {
-        let body = bytes.get(..CRC_AT)?;
-        let crc = u16::from_le_bytes([*bytes.get(CRC_AT)?, *bytes.get(CRC_AT + 1)?]);
-        if bytes.get(..4)? != MAGIC || *bytes.get(4)? != VERSION || CCITT.checksum(body) != crc {
-            return None;
-        }
         let mut settings = Settings::factory();
-        settings.name = Text::new(bytes.get(5..16)?)?;
-        for (n, size) in settings.allocation.iter_mut().enumerate() {
-            *size = u32::from_le_bytes(bytes.get(16 + 4 * n..20 + 4 * n)?.try_into().ok()?);
-        }
-        for (n, file) in settings.files.iter_mut().enumerate() {
-            let at = FILES_AT + n * ENCODED_LEN;
-            *file = FileConfig::decode(bytes.get(at..at + ENCODED_LEN)?.try_into().ok()?)?;
-        }
-        settings.saved_at = TimeStamp::decode(bytes.get(SAVED_AT..CRC_AT)?.try_into().ok()?);
-        Some(settings)
+        let read = |at: usize, buf: &mut [u8]| match bytes.get(at..at + buf.len()) {
+            Some(src) => {
+                buf.copy_from_slice(src);
+                true
+            }
+            None => false,
+        };
+        settings.read_from(read).then_some(settings)
     }
 }
 
@@ -120,5 +185,8 @@ mod tests {
             assert_eq!(Settings::decode(&bad), None, "byte {at} flipped");
         }
         assert_eq!(Settings::decode(&[0; LEN]), None, "an empty file");
+        let mut reset = s;
+        reset.reset();
+        assert_eq!(reset, Settings::factory());
     }
 }

@@ -53,7 +53,8 @@ pub const RESET_COUNT: u32 = 0x55;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Text<const N: usize> {
     bytes: [u8; N],
-    len: usize,
+    /// Bytes in use (`N` is at most 11).
+    len: u8,
 }
 
 impl<const N: usize> Default for Text<N> {
@@ -69,11 +70,11 @@ impl<const N: usize> Text<N> {
         let value = value.get(..end)?;
         let mut bytes = [0; N];
         bytes.get_mut(..value.len())?.copy_from_slice(value);
-        Some(Text { bytes, len: value.len() })
+        Some(Text { bytes, len: u8::try_from(value.len()).ok()? })
     }
 
     pub fn as_bytes(&self) -> &[u8] {
-        self.bytes.get(..self.len).unwrap_or(&[])
+        self.bytes.get(..usize::from(self.len)).unwrap_or(&[])
     }
 }
 

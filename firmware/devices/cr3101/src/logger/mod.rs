@@ -28,6 +28,8 @@ const SAVE_DELAY_US: u64 = 1_000_000;
 /// How far past its saved write pointer a file is searched for records written after the
 /// save: more than a second of records at the manual's one per millisecond.
 const RECOVER_RECORDS: u32 = 2048;
+/// A card block: the configuration file is written one at a time.
+const BLOCK: usize = 512;
 
 /// What the card slot shows (2001h, 1002h).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -156,6 +158,11 @@ impl<D: BlockDevice> Logger<D> {
     /// A card was inserted: mounts it, reads its configuration (or gives a new card the
     /// factory one) and opens its files. A card without a usable volume is handed back and
     /// shows as unusable until it leaves the slot.
+    ///
+    /// Never inlined: the mounted card passes through its frame (a volume manager with its
+    /// block cache, over a kilobyte), which would otherwise be reserved by every caller's
+    /// frame on every call.
+    #[inline(never)]
     pub fn insert(&mut self, device: D, write_protected: bool) -> Result<(), D> {
         if let Some(old) = self.remove() {
             // The slot holds one card: the old one's device goes with the new one's refusal.
@@ -171,12 +178,12 @@ impl<D: BlockDevice> Logger<D> {
             }
         };
         let capacity = if write_protected { 0 } else { card.capacity().map_or(0, |c| u32::try_from(c).unwrap_or(u32::MAX)) };
-        let mut bytes = [0; settings::LEN];
-        let stored = card
-            .open_read_only(SETTINGS_SLOT, settings::FILE_NAME)
-            .ok()
-            .and_then(|_| card.read_at(SETTINGS_SLOT, 0, &mut bytes).ok())
-            .and_then(|()| Settings::decode(&bytes));
+        // Read a piece at a time into the settings themselves (factory ones if it fails).
+        let stored = card.open_read_only(SETTINGS_SLOT, settings::FILE_NAME).is_ok()
+            && self.settings.read_from(|at, buf| card.read_at(SETTINGS_SLOT, at as u32, buf).is_ok());
+        if !stored {
+            self.settings.reset();
+        }
         let _ = card.close(SETTINGS_SLOT);
         if !write_protected {
             // A new card gets its configuration file now, so a PC sees what the device uses.
@@ -184,19 +191,17 @@ impl<D: BlockDevice> Logger<D> {
                 self.card_errors = self.card_errors.wrapping_add(1);
             }
         }
-        let settings = stored.unwrap_or_else(Settings::factory);
-        self.settings = settings;
-        self.allocation = settings.allocation.map(RedundantPair::new);
+        self.allocation = self.settings.allocation.map(RedundantPair::new);
         self.card = Some(card);
         self.status = CardStatus { inserted: true, write_protected, capacity, unusable: false };
-        if stored.is_none() {
+        if !stored {
             let _ = self.save_settings();
         }
         let now = self.now_us;
         for n in 0..FILES {
             // A file that cannot be opened is counted, and its accesses refused.
             let _ = self.open_file(n, false);
-            if let (Some(run), Some(file)) = (self.runs.get_mut(n), settings.files.get(n)) {
+            if let (Some(run), Some(file)) = (self.runs.get_mut(n), self.settings.files.get(n)) {
                 *run = FileRun::new(file.layout());
                 run.restart(file, now);
             }
@@ -249,7 +254,8 @@ impl<D: BlockDevice> Logger<D> {
     }
 
     /// The card is to be removed, or was: moved pointers are saved while it still can be,
-    /// its files closed, and its device handed back.
+    /// its files closed, and its device handed back. Never inlined, as [`Logger::insert`].
+    #[inline(never)]
     pub fn remove(&mut self) -> Option<D> {
         if self.save_at_us.is_some() {
             let _ = self.save_settings();
@@ -306,28 +312,32 @@ impl<D: BlockDevice> Logger<D> {
             return Ok(());
         }
         self.settings.saved_at = self.now();
-        let bytes = self.settings.encode();
         let card = self.card.as_mut().ok_or(CardError::NoVolume)?;
-        card.write_at(SETTINGS_SLOT, 0, &bytes).inspect_err(|_| self.card_errors = self.card_errors.wrapping_add(1))
-    }
-
-    /// A configuration write: it needs a card, and is saved on it at once (erratum CR-48).
-    fn configure(&mut self, change: impl FnOnce(&mut Settings) -> Result<(), SdoAbort>) -> Result<(), SdoAbort> {
-        self.card()?;
-        let mut settings = self.settings;
-        change(&mut settings)?;
-        self.settings = settings;
-        self.save_settings().map_err(abort)
+        // A block of the file at a time: one card write each, and never the whole file on
+        // the stack.
+        let mut written = Ok(());
+        for start in (0..settings::LEN).step_by(BLOCK) {
+            let mut block = [0; BLOCK];
+            self.settings.pieces(|at, bytes| {
+                for (i, &b) in bytes.iter().enumerate() {
+                    if let Some(dst) = (at + i).checked_sub(start).and_then(|o| block.get_mut(o)) {
+                        *dst = b;
+                    }
+                }
+            });
+            written = written.and_then(|()| card.write_at(SETTINGS_SLOT, start as u32, &block));
+        }
+        written.inspect_err(|_| self.card_errors = self.card_errors.wrapping_add(1))
     }
 
     // ---- 2000h, 2002h/2003h ----
 
+    /// 2000h: it needs a card, and is saved on it at once (erratum CR-48).
     pub fn set_card_name(&mut self, value: &[u8]) -> Result<(), SdoAbort> {
         let name = file_config::Text::new(value).ok_or(SdoAbort::LengthTooHigh)?;
-        self.configure(|s| {
-            s.name = name;
-            Ok(())
-        })
+        self.card()?;
+        self.settings.name = name;
+        self.save_settings().map_err(abort)
     }
 
     /// 2002h (`shadow` false) or 2003h sub `n + 1`.
@@ -344,12 +354,10 @@ impl<D: BlockDevice> Logger<D> {
         let pair = self.allocation.get_mut(n).ok_or(SdoAbort::NoSubIndex)?;
         let changed = if shadow { pair.write_second(size) } else { pair.write_first(size) };
         let Some(size) = changed else { return Ok(()) };
-        let mut settings = self.settings;
-        if let (Some(s), Some(file)) = (settings.allocation.get_mut(n), settings.files.get_mut(n)) {
+        if let (Some(s), Some(file)) = (self.settings.allocation.get_mut(n), self.settings.files.get_mut(n)) {
             *s = size;
             file.reset_pointers();
         }
-        self.settings = settings;
         let laid_out = self.open_file(n, true);
         if let (Some(run), Some(file)) = (self.runs.get_mut(n), self.settings.files.get(n)) {
             *run = FileRun::new(file.layout());
@@ -365,13 +373,20 @@ impl<D: BlockDevice> Logger<D> {
         self.settings.files.get(n).ok_or(SdoAbort::NoObject)
     }
 
-    /// Changes file `n`'s configuration; a change of its name opens (or lays out) the file
-    /// of the new name, a change of its records' layout or mode starts its run afresh.
+    /// Changes file `n`'s configuration, which needs a card and is saved on it at once
+    /// (erratum CR-48); a change of its name opens (or lays out) the file of the new name, a
+    /// change of its records' layout or mode starts its run afresh.
     pub fn configure_file(&mut self, n: usize, change: impl FnOnce(&mut FileConfig, u32) -> Result<(), SdoAbort>) -> Result<(), SdoAbort> {
         let before = *self.file(n)?;
         let size = self.settings.allocation.get(n).copied().unwrap_or(0);
-        self.configure(|s| s.files.get_mut(n).ok_or(SdoAbort::NoObject).and_then(|f| change(f, size)))?;
-        let after = *self.file(n)?;
+        self.card()?;
+        // A refused change leaves the file as it was.
+        let mut after = before;
+        change(&mut after, size)?;
+        if let Some(file) = self.settings.files.get_mut(n) {
+            *file = after;
+        }
+        self.save_settings().map_err(abort)?;
         if (before.name(), before.extension()) != (after.name(), after.extension()) {
             self.open_file(n, false).map_err(abort)?;
         }
