@@ -418,3 +418,30 @@ fn the_status_leds_show_operational_and_card_access() {
     assert!(!d.status_leds().card_access, "a pulse per record");
     assert_eq!(d.console("leds").unwrap(), "leds lit: on can");
 }
+
+#[test]
+fn an_rpdo_moved_to_another_identifier_logs_from_there() {
+    let path = image("cobid");
+    let mut d = device(&path);
+    configure(&mut d, 1, b"MOVED", 0x03, 0, false, 10);
+    // CiA 301: invalid first, then the new identifier.
+    write(&mut d, 0x1401, 1, &(0x8000_0000_u32 | 0x300 + u32::from(NODE)).to_le_bytes()).unwrap();
+    write(&mut d, 0x1401, 1, &0x333_u32.to_le_bytes()).unwrap();
+    operational(&mut d, MS);
+    d.on_frame(&CanFrame::data(0x300 + u16::from(NODE), &payload(1)).unwrap(), 2 * MS);
+    assert_eq!(u32_of(read(&mut d, 0x3105, 0).unwrap()), 0, "the old identifier is no longer file 2's");
+    d.on_frame(&CanFrame::data(0x333, &payload(2)).unwrap(), 3 * MS);
+    assert_eq!(u32_of(read(&mut d, 0x3105, 0).unwrap()), 1);
+    // Saved automatically (CR-06): a reset communication keeps it.
+    d.on_frame(&CanFrame::data(0, &[0x82, NODE]).unwrap(), 4 * MS);
+    operational(&mut d, 5 * MS);
+    d.on_frame(&CanFrame::data(0x300 + u16::from(NODE), &payload(3)).unwrap(), 6 * MS);
+    d.on_frame(&CanFrame::data(0x333, &payload(4)).unwrap(), 7 * MS);
+    assert_eq!(u32_of(read(&mut d, 0x3105, 0).unwrap()), 2);
+    // Restoring the defaults (1011h "load") and a reset bring the default back.
+    write(&mut d, 0x1011, 1, b"load").unwrap();
+    d.on_frame(&CanFrame::data(0, &[0x82, NODE]).unwrap(), 8 * MS);
+    operational(&mut d, 9 * MS);
+    d.on_frame(&CanFrame::data(0x300 + u16::from(NODE), &payload(5)).unwrap(), 10 * MS);
+    assert_eq!(u32_of(read(&mut d, 0x3105, 0).unwrap()), 3);
+}

@@ -181,17 +181,21 @@ impl Clock {
         Ok(())
     }
 
-    /// The time FAT directory entries take (two-second resolution on the card).
+    /// The time FAT directory entries take at `now_us`.
     pub fn fat_time(&self, now_us: u64) -> embedded_sdmmc::Timestamp {
-        let t = self.now(now_us);
-        embedded_sdmmc::Timestamp {
-            year_since_1970: t.year.saturating_add(30),
-            zero_indexed_month: t.month.saturating_sub(1),
-            zero_indexed_day: t.day.saturating_sub(1),
-            hours: t.hour,
-            minutes: t.minute,
-            seconds: t.second,
-        }
+        fat_time_of(&self.now(now_us))
+    }
+}
+
+/// `t` as FAT directory entries keep it (two-second resolution on the card).
+pub fn fat_time_of(t: &TimeStamp) -> embedded_sdmmc::Timestamp {
+    embedded_sdmmc::Timestamp {
+        year_since_1970: t.year.saturating_add(30),
+        zero_indexed_month: t.month.saturating_sub(1),
+        zero_indexed_day: t.day.saturating_sub(1),
+        hours: t.hour,
+        minutes: t.minute,
+        seconds: t.second,
     }
 }
 

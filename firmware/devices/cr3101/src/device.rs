@@ -330,7 +330,10 @@ impl<B: Board, S: ParamStore> Device for Cr3101<B, S> {
             Some(0) if operational && !frame.rtr => self.answer(frame.payload()),
             _ => {
                 self.node.on_frame(frame, now_us);
-                self.refresh_rpdo_ids();
+                // An NMT command (a reset) or a write to 1400h..1407h may have moved them.
+                if frame.id == 0 || core::mem::take(&mut self.logger_mut().rpdo_parameters_written) {
+                    self.refresh_rpdo_ids();
+                }
             }
         }
         self.update(now_us);

@@ -10,7 +10,7 @@ use crate::card::record::ComponentType;
 use crate::clock::Field;
 use crate::logger::Logger;
 use crate::logger::file_config::{Component, RING, Text};
-use coforge_stack::od::{ReadLen, SdoAbort, read_slice};
+use coforge_stack::od::{ReadLen, SdoAbort, WriteSource, read_slice};
 use embedded_sdmmc::BlockDevice;
 
 fn u8_of(data: &[u8]) -> Result<u8, SdoAbort> {
@@ -42,6 +42,14 @@ fn read_field(field: Field, t: &crate::card::record::TimeStamp, offset: usize, b
 }
 
 impl<D: BlockDevice> Hooks for Logger<D> {
+    /// The device reads the RPDOs' identifiers again after a write to their parameters,
+    /// rather than at every frame.
+    fn written(&mut self, index: u16, _sub: u8, _data: &[u8], _by: WriteSource) {
+        if (0x1400..0x1400 + FILES as u16).contains(&index) {
+            self.rpdo_parameters_written = true;
+        }
+    }
+
     fn read_name_of_the_memory_card(&mut self, offset: usize, buf: &mut [u8]) -> Result<ReadLen, SdoAbort> {
         self.require_card()?;
         read_slice(self.settings().name.as_bytes(), offset, buf)

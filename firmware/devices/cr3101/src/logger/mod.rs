@@ -71,6 +71,9 @@ pub struct Logger<D: BlockDevice> {
     pub card_errors: u32,
     /// Records written to the card.
     card_writes: u32,
+    /// An RPDO's communication parameters were written: the device reads their identifiers
+    /// again.
+    pub(crate) rpdo_parameters_written: bool,
 }
 
 impl<D: BlockDevice> core::fmt::Debug for Logger<D> {
@@ -105,13 +108,19 @@ impl<D: BlockDevice> Logger<D> {
             save_at_us: None,
             card_errors: 0,
             card_writes: 0,
+            rpdo_parameters_written: false,
         }
     }
 
     /// The time of the input being handled (the hooks have no clock of their own).
     pub fn set_now(&mut self, now_us: u64) {
         self.now_us = now_us;
-        FatClock::set(&self.clock.fat_time(now_us));
+    }
+
+    /// Publishes the time `t` for the FAT directory entries of what is written next (a
+    /// calendar conversion: only before a card write, not at every input).
+    fn publish_fat_time(t: &TimeStamp) {
+        FatClock::set(&crate::clock::fat_time_of(t));
     }
 
     pub fn set_operational(&mut self, operational: bool) {
@@ -275,6 +284,7 @@ impl<D: BlockDevice> Logger<D> {
         let len = file.file_name(&mut name);
         let name = core::str::from_utf8(name.get(..len).unwrap_or_default()).map_err(|_| CardError::Name)?;
         let protected = self.status.write_protected;
+        Self::publish_fat_time(&self.clock.now(self.now_us));
         let card = self.card.as_mut().ok_or(CardError::NoVolume)?;
         let opened = match size {
             0 => card.close(n),
@@ -312,6 +322,7 @@ impl<D: BlockDevice> Logger<D> {
             return Ok(());
         }
         self.settings.saved_at = self.now();
+        Self::publish_fat_time(&self.settings.saved_at);
         let card = self.card.as_mut().ok_or(CardError::NoVolume)?;
         // A block of the file at a time: one card write each, and never the whole file on
         // the stack.
@@ -499,6 +510,7 @@ impl<D: BlockDevice> Logger<D> {
 
     /// Writes `record` at record address `at` of file `n`.
     fn write_record(&mut self, n: usize, at: u32, record: &Record) -> Result<(), SdoAbort> {
+        Self::publish_fat_time(&record.time_stamp());
         let offset = at.saturating_mul(record.as_bytes().len() as u32);
         let written = self.writable_card()?.write_at(n, offset, record.as_bytes());
         match written {
@@ -573,13 +585,10 @@ impl<D: BlockDevice> Logger<D> {
         self.set_now(now_us);
         let mut next: Option<u64> = None;
         for n in 0..FILES {
-            let Some(file) = self.settings.files.get(n).copied() else { continue };
-            let due = self.runs.get(n).and_then(|r| r.due(&file, self.operational));
-            if let Some(t) = due.filter(|&t| t <= now_us) {
+            if let Some(t) = self.due(n).filter(|&t| t <= now_us) {
                 self.commit(n, t);
             }
-            let file = self.settings.files.get(n).copied().unwrap_or(file);
-            let after = self.runs.get(n).and_then(|r| r.due(&file, self.operational));
+            let after = self.due(n);
             next = match (next, after) {
                 (Some(a), Some(b)) => Some(a.min(b)),
                 (a, b) => a.or(b),
@@ -592,6 +601,12 @@ impl<D: BlockDevice> Logger<D> {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         }
+    }
+
+    /// When file `n` next writes a record by itself (a cyclic record, a window closing).
+    fn due(&self, n: usize) -> Option<u64> {
+        let (run, file) = (self.runs.get(n)?, self.settings.files.get(n)?);
+        run.due(file, self.operational)
     }
 
     /// PDO read mode: the answer to a request for `part` (0 values, 1 time stamp) of `record`
