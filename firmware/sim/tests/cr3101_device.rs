@@ -425,7 +425,7 @@ fn an_rpdo_moved_to_another_identifier_logs_from_there() {
     let mut d = device(&path);
     configure(&mut d, 1, b"MOVED", 0x03, 0, false, 10);
     // CiA 301: invalid first, then the new identifier.
-    write(&mut d, 0x1401, 1, &(0x8000_0000_u32 | 0x300 + u32::from(NODE)).to_le_bytes()).unwrap();
+    write(&mut d, 0x1401, 1, &(0x8000_0000_u32 | (0x300 + u32::from(NODE))).to_le_bytes()).unwrap();
     write(&mut d, 0x1401, 1, &0x333_u32.to_le_bytes()).unwrap();
     operational(&mut d, MS);
     d.on_frame(&CanFrame::data(0x300 + u16::from(NODE), &payload(1)).unwrap(), 2 * MS);
