@@ -2,8 +2,8 @@
 //! a corrupt or torn block is ignored so the node keeps the spec defaults.
 
 use co401gw1::{Mode, Od};
-use coforge_stack::od::{AccessContext, Area, EntryAccess, NmtState, NoAppObjects, Side};
 use coforge_stack::od::NodeDictionary;
+use coforge_stack::od::{AccessContext, Area, EntryAccess, NmtState, NoAppObjects, Side};
 use coforge_stack::store::{BlockStore, MAX_SLOTS, ParamStore};
 use coforge_storage::ram::RamEeprom;
 
