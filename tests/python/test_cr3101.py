@@ -464,3 +464,100 @@ def test_a_power_cut_while_logging_leaves_the_card_clean_and_every_record_writte
         dev.close()
     clean, report = fsck_clean(card, tmp_path)
     assert clean, report
+
+
+def emcy_codes(dev, mark):
+    """(code, byte 3) of every emergency since `mark`."""
+    return [(struct.unpack_from("<H", bytes(f.data))[0], f.data[3]) for f in dev.rec.since(mark, 0x80 + NODE)]
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_cyclic_ring_and_direct_writing_files(tmp_path, kind):
+    """Cyclic writing into a ring of 4 records every 50 ms (the wrap an emergency event), direct
+    writing at 3x04h, and a linear autoincrement file whose end switches it to direct reading."""
+    card = new_card(tmp_path)
+    dev = Logger(tmp_path, card, kind)
+    try:
+        dev.configure(0, b"CYCLE", 0x02, 5, 4)
+        dev.write(0x3003, 2, 0x55, "<B")  # ring
+        dev.configure(1, b"DIRECT", 0x01, 1, 8)
+        dev.configure(2, b"LINEAR", 0x03, 0, 3)
+        dev.write(0x5000, 8, 4711, "<H")
+        mark = dev.rec.mark()
+        dev.node.nmt.state = "OPERATIONAL"
+        time.sleep(0.6)  # some 12 cycles: three times round the ring
+        dev.node.nmt.state = "PRE-OPERATIONAL"
+        assert dev.read(0x3006, 0, "<I") == 4, "a ring holds 4 records"
+        wraps = [c for c in emcy_codes(dev, mark) if c == (0x6200, 1)]
+        assert len(wraps) >= 2, f"6200h with file 1 at each wrap: {emcy_codes(dev, mark)}"
+        # Direct writing: record 5, each write stamped.
+        dev.write(0x3104, 0, 5, "<I")
+        dev.write(0x5100, 8, 0xBEEF, "<H")
+        dev.write(0x5100, 9, -5, "<i")
+        with pytest.raises(canopen.SdoAbortedError) as refused:
+            dev.write(0x5100, 9, 7, "<H")
+        assert refused.value.code == 0x0607_0010, "a DINT takes 4 bytes"
+        # Linear autoincrement: 3 records, then the file is full and reads directly.
+        dev.node.nmt.state = "OPERATIONAL"
+        mark = dev.rec.mark()
+        for n in range(5):
+            dev.net.send_message(0x400 + NODE, values(n))
+            time.sleep(0.02)
+        time.sleep(0.2)
+        assert (0x6200, 3) in emcy_codes(dev, mark), "file 3 reached its end"
+        assert dev.read(0x3203, 1, "<B") == 0x10, "switched to direct reading"
+        assert dev.read(0x3205, 0, "<I") == 3
+        remove_card(dev)
+    finally:
+        dev.close()
+    cycle = copy_out(card, tmp_path, "CYCLE.DAT")
+    records = [cycle[i * RECORD : (i + 1) * RECORD] for i in range(4)]
+    assert all(r[9:11] == struct.pack("<H", 4711) for r in records), "every cycle records the last value"
+    direct = copy_out(card, tmp_path, "DIRECT.DAT")
+    assert direct[5 * RECORD + 8] == 0b11 and direct[5 * RECORD + 9 : 5 * RECORD + 15] == struct.pack("<Hi", 0xBEEF, -5)
+    assert direct[: 5 * RECORD] == bytes(5 * RECORD), "only record 5 written"
+    linear = copy_out(card, tmp_path, "LINEAR.DAT")
+    assert [linear[i * RECORD + 9 : (i + 1) * RECORD] for i in range(3)] == [values(n) for n in range(3)], "frames after the end refused"
+    clean, report = fsck_clean(card, tmp_path)
+    assert clean, report
+
+
+def test_pairs_no_card_and_a_full_card(tmp_path):
+    """The node-ID pair takes effect at the next power-on only when both halves agree; without a
+    card, card data is refused with 0800 0020h and EMCY 5001h; an allocation the card cannot
+    hold is refused and leaves the card clean."""
+    card = new_card(tmp_path)
+    dev = Logger(tmp_path, card)
+    try:
+        dev.write(0x20F0, 0, 0x25, "<B")
+        # 16 MiB card: two halves of 20 MiB agree, and the card refuses.
+        dev.write(0x2002, 1, 20 << 20, "<I")
+        with pytest.raises(canopen.SdoAbortedError) as full:
+            dev.write(0x2003, 1, 20 << 20, "<I")
+        assert full.value.code == 0x0800_0020
+        mark = dev.rec.mark()
+        remove_card(dev)
+        with pytest.raises(canopen.SdoAbortedError) as none:
+            dev.read(0x3000, 1)
+        assert none.value.code == 0x0800_0020
+        assert dev.rec.wait(0x80 + NODE, mark, 2.0, lambda f: bytes(f.data[:2]) == b"\x01\x50"), "EMCY 5001h"
+        assert dev.read(0x1002, 0, "<I") & 1 == 0
+    finally:
+        dev.close()
+    clean, report = fsck_clean(card, tmp_path)
+    assert clean, report
+    # Only 20F0h was written: the next power-on keeps node-ID 20h (CR-47). Then both halves.
+    dev = Logger(tmp_path, card)
+    try:
+        assert dev.read(0x100B, 0, "<I") == NODE
+        dev.write(0x20F1, 0, 0x25, "<B")
+    finally:
+        dev.close()
+    dev = Logger(tmp_path, card)
+    try:
+        moved = canopen.RemoteNode(0x25, canopen.ObjectDictionary())
+        moved.sdo.RESPONSE_TIMEOUT = 2.0
+        dev.net.add_node(moved)
+        assert struct.unpack("<I", moved.sdo.upload(0x100B, 0))[0] == 0x25, "both halves agree: node-ID 25h"
+    finally:
+        dev.close()
