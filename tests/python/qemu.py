@@ -11,17 +11,21 @@ from test_e2e_memory1 import COFORGE, free_port
 
 
 class QemuProcess:
-    """`image` run in `workdir` (where semihosting keeps its files) with `uarts` UARTs;
-    `serial_url` is UART0, `can_url` the hub on UART1, `ports` every UART's TCP port."""
+    """`image` run in `workdir` (where semihosting keeps its files) with `uarts` UARTs and the
+    QEMU arguments `extra` (a drive); `serial_url` is UART0, `can_url` the hub on UART1, `ports`
+    every UART's TCP port; with `monitor`, the QEMU monitor listens on `monitor_port`."""
 
-    def __init__(self, image, workdir, uarts=2):
+    def __init__(self, image, workdir, uarts=2, extra=(), monitor=False):
         assert pathlib.Path(image).exists(), f"no QEMU image at {image}: run `cargo xtask dist`"
         self.ports = [free_port() for _ in range(uarts)]
+        self.monitor_port = free_port() if monitor else None
         self.output = tempfile.TemporaryFile()
         self.hub = None
+        self.cut = False
+        monitor_arg = f"tcp:127.0.0.1:{self.monitor_port},server=on,wait=off" if monitor else "none"
         self.qemu = subprocess.Popen(
-            ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", "none",
-             "-semihosting-config", "enable=on,target=native", "-kernel", image,
+            ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", monitor_arg,
+             "-semihosting-config", "enable=on,target=native", "-kernel", image, *extra,
              *(arg for port in self.ports for arg in ("-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"))],
             stdin=subprocess.DEVNULL, stdout=self.output, stderr=subprocess.STDOUT, cwd=workdir,
         )
@@ -40,9 +44,15 @@ class QemuProcess:
         text = self.output.read().decode(errors="replace")
         return f"; QEMU printed: {text}" if text else ""
 
+    def power_cut(self):
+        """QEMU killed: nothing is closed or flushed."""
+        self.cut = True
+        self.qemu.kill()
+        self.qemu.wait(timeout=10)
+
     def stop(self):
         """Stops QEMU and the hub; fails if QEMU had exited by itself (a panic), with its output."""
-        exited = self.qemu.poll()
+        exited = None if self.cut else self.qemu.poll()
         for proc in (self.hub, self.qemu):
             if proc is not None:
                 proc.kill()

@@ -21,12 +21,9 @@ switch, and QEMU refuses a read-only drive as an SD card.
 import datetime
 import os
 import pathlib
-import re
-import shutil
 import socket
 import struct
 import subprocess
-import tempfile
 import threading
 import time
 
@@ -34,14 +31,14 @@ import canopen
 import pytest
 
 from bus import Recorder
+from card import MTOOLS, copy_out, fsck_clean, listing, new_card
+from qemu import QemuProcess
 from simproc import SimProcess
-from test_e2e_memory1 import free_port
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 # Absolute: QEMU runs in a test's own directory, where it keeps the parameter file.
 IMAGE = str(pathlib.Path(os.environ.get("COFORGE_CR3101_QEMU_IMAGE", ROOT / "target" / "dist" / "images" / "cr3101-qemu.bin")).resolve())
-MTOOLS = dict(os.environ, MTOOLS_SKIP_CHECK="1")
 KINDS = ["sim", "qemu"]
 NODE = 0x20
 # Component 1 WORD, 2 DINT, 4 BYTE: 9 + 2 + 4 + 1 = 16-byte records.
@@ -50,34 +47,14 @@ RELEVANT, RECORD = 0b1011, 16
 FRAMES = 1000
 
 
-class QemuCr3101:
+class QemuCr3101(QemuProcess):
     """The image in QEMU, run in `workdir`, with the card image `card` in its SD slot: UART0
     unused, UART1 (SLCAN) on a `coforge hub` (`can_url`), UART2 its console, the monitor on a
     TCP port."""
 
     def __init__(self, workdir, card):
-        assert pathlib.Path(IMAGE).exists(), f"no QEMU image at {IMAGE}: run `cargo xtask dist`"
-        self.ports = [free_port() for _ in range(4)]
-        uarts = self.ports[:3]
-        self.output = tempfile.TemporaryFile()
-        self.hub = self.monitor_sock = self.console_sock = None
-        self.cut = False
-        self.qemu = subprocess.Popen(
-            ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic",
-             "-monitor", f"tcp:127.0.0.1:{self.ports[3]},server=on,wait=off",
-             "-semihosting-config", "enable=on,target=native", "-kernel", IMAGE,
-             "-drive", f"if=sd,format=raw,file={card}",
-             *(arg for port in uarts for arg in ("-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"))],
-            stdin=subprocess.DEVNULL, stdout=self.output, stderr=subprocess.STDOUT, cwd=workdir,
-        )
-        try:
-            self.hub = subprocess.Popen([COFORGE, "hub", "--port", "0", "--connect", f"127.0.0.1:{uarts[1]}"], stdout=subprocess.PIPE, text=True)
-            hub = re.search(r"on slcan (socket://\S+)", self.hub.stdout.readline())
-            assert hub, f"coforge hub banner{self.output_note()}"
-            self.can_url = hub.group(1)
-        except BaseException:
-            self.stop()
-            raise
+        self.monitor_sock = self.console_sock = None
+        super().__init__(IMAGE, workdir, uarts=3, extra=["-drive", f"if=sd,format=raw,file={card}"], monitor=True)
 
     def _connect(self, port, timeout=10.0):
         deadline = time.monotonic() + timeout
@@ -106,7 +83,7 @@ class QemuCr3101:
             return d.endswith(b"(qemu) ")
 
         if self.monitor_sock is None:
-            self.monitor_sock = self._connect(self.ports[3])
+            self.monitor_sock = self._connect(self.monitor_port)
             self._until(self.monitor_sock, prompt)
         self.monitor_sock.sendall(command.encode() + b"\n")
         out = self._until(self.monitor_sock, lambda d: b"\r\n" in d and prompt(d))
@@ -121,32 +98,11 @@ class QemuCr3101:
         assert line.startswith("ok "), f"console {command!r}: {line!r}"
         return line[len("ok ") :]
 
-    def output_note(self):
-        self.output.seek(0)
-        text = self.output.read().decode(errors="replace")
-        return f"; QEMU printed: {text}" if text else ""
-
-    def power_cut(self):
-        """QEMU killed: nothing is closed or flushed."""
-        self.cut = True
-        self.qemu.kill()
-        self.qemu.wait(timeout=10)
-
     def stop(self):
-        """Stops QEMU and the hub; fails if QEMU had exited by itself (a panic), with its output."""
-        exited = None if self.cut else self.qemu.poll()
         for sock in (self.monitor_sock, self.console_sock):
             if sock is not None:
                 sock.close()
-        for proc in (self.hub, self.qemu):
-            if proc is not None:
-                proc.kill()
-                proc.wait(timeout=10)
-        if self.hub is not None:
-            self.hub.stdout.close()
-        note = self.output_note()
-        self.output.close()
-        assert exited is None, f"QEMU exited by itself with {exited}{note}"
+        super().stop()
 
 
 class Logger:
@@ -240,27 +196,6 @@ def values(n):
     return struct.pack("<HiB", n & 0xFFFF, -1000 * n, n % 251)
 
 
-def new_card(tmp_path):
-    for tool in ("mdir", "mcopy", "fsck.fat"):
-        assert shutil.which(tool), f"{tool} is missing: cargo xtask test installs mtools and dosfstools"
-    card = tmp_path / "card.img"
-    subprocess.run([COFORGE, "card", card, "--mib", "16", "--label", "CANMEM"], check=True, timeout=60)
-    return card
-
-
-def copy_out(card, tmp_path, name):
-    out = tmp_path / name
-    subprocess.run(["mcopy", "-o", "-n", "-i", f"{card}@@1M", f"::{name}", out], env=MTOOLS, check=True)
-    return out.read_bytes()
-
-
-def fsck_clean(card, tmp_path):
-    partition = tmp_path / "partition.img"
-    partition.write_bytes(card.read_bytes()[1 << 20 :])
-    fsck = subprocess.run(["fsck.fat", "-n", partition], capture_output=True, text=True)
-    return fsck.returncode == 0, fsck.stdout + fsck.stderr
-
-
 # The image's clock at power-on.
 POWER_ON = datetime.datetime(2026, 1, 1, tzinfo=datetime.timezone.utc)
 
@@ -295,8 +230,8 @@ def test_a_logging_session_reads_back_record_by_record_with_mtools(tmp_path, kin
         remove_card(dev)
     finally:
         dev.close()
-    listing = subprocess.run(["mdir", "-b", "-i", f"{card}@@1M", "::"], env=MTOOLS, capture_output=True, text=True, check=True).stdout
-    assert "OIL_TEMP.DAT" in listing and "CANMEM.CFG" in listing, listing
+    names = listing(card)
+    assert "OIL_TEMP.DAT" in names and "CANMEM.CFG" in names, names
     data = copy_out(card, tmp_path, "OIL_TEMP.DAT")
     assert len(data) == 200 * RECORD
     previous = None

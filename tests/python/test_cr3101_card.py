@@ -9,16 +9,16 @@ record written before the cut reads back.
 
 import os
 import pathlib
-import shutil
 import struct
 import subprocess
 
 import pytest
 
+from card import copy_out, fsck_clean, listing, new_card
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 IMAGE = os.environ.get("COFORGE_CARD_QEMU_IMAGE", str(ROOT / "firmware/boards/qemu/target/thumbv7m-none-eabi/release/cr3101-card"))
-MTOOLS = dict(os.environ, MTOOLS_SKIP_CHECK="1")
 
 
 def record(n):
@@ -27,13 +27,9 @@ def record(n):
     return stamp + bytes([0b1011]) + struct.pack("<Hi", n & 0xFFFF, -n * 1000) + bytes([n % 251])
 
 
-def new_card(tmp_path):
+def new_card_for_the_image(tmp_path):
     assert pathlib.Path(IMAGE).exists(), f"no card image at {IMAGE}: cargo xtask test builds it"
-    for tool in ("mdir", "mcopy", "fsck.fat"):
-        assert shutil.which(tool), f"{tool} is missing: cargo xtask test installs mtools and dosfstools"
-    card = tmp_path / "card.img"
-    subprocess.run([COFORGE, "card", card, "--mib", "16", "--label", "CANMEM"], check=True, timeout=60)
-    return card
+    return new_card(tmp_path)
 
 
 def qemu(card):
@@ -42,27 +38,14 @@ def qemu(card):
             "-drive", f"if=sd,format=raw,file={card}"]
 
 
-def copy_out(card, tmp_path, name):
-    out = tmp_path / name
-    subprocess.run(["mcopy", "-o", "-n", "-i", f"{card}@@1M", f"::{name}", out], env=MTOOLS, check=True)
-    return out.read_bytes()
-
-
-def fsck_clean(card, tmp_path):
-    partition = tmp_path / "partition.img"
-    partition.write_bytes(card.read_bytes()[1 << 20:])
-    fsck = subprocess.run(["fsck.fat", "-n", partition], capture_output=True, text=True)
-    return fsck.returncode == 0, fsck.stdout + fsck.stderr
-
-
 def test_records_on_the_emulated_sd_card_read_back_with_mtools_and_fsck_clean(tmp_path):
-    card = new_card(tmp_path)
+    card = new_card_for_the_image(tmp_path)
     run = subprocess.run(qemu(card), stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, f"the image failed: {run.stdout}{run.stderr}"
     assert "200 records written" in run.stdout
 
-    listing = subprocess.run(["mdir", "-i", f"{card}@@1M", "-b", "::"], env=MTOOLS, check=True, capture_output=True, text=True).stdout
-    assert "OIL_TEMP.DAT" in listing and "PRESS.DAT" in listing, listing
+    names = listing(card)
+    assert "OIL_TEMP.DAT" in names and "PRESS.DAT" in names, names
     assert copy_out(card, tmp_path, "OIL_TEMP.DAT") == b"".join(record(n) for n in range(200))
     clean, report = fsck_clean(card, tmp_path)
     assert clean, report
@@ -70,7 +53,7 @@ def test_records_on_the_emulated_sd_card_read_back_with_mtools_and_fsck_clean(tm
 
 @pytest.mark.parametrize("cut_after", [0, 57, 150])
 def test_a_power_cut_while_logging_leaves_the_card_clean_and_every_record_before_it(tmp_path, cut_after):
-    card = new_card(tmp_path)
+    card = new_card_for_the_image(tmp_path)
     proc = subprocess.Popen(qemu(card), stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         for line in proc.stdout:
