@@ -64,10 +64,15 @@ pub fn installed() -> bool {
     Command::new("cargo").args(["kani", "--version"]).stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok_and(|s| s.success())
 }
 
-/// The device crates whose generated `serial::proofs` hold Kani harnesses (one per serial
-/// command and one for the decoder), with their specs. A harness of theirs is named
-/// `<crate>/<path>`; a name without a crate is one of `verification/`.
-const DEVICE_CRATES: &[(&str, &str)] = &[("co401memory1", "spec/co401memory1.yaml"), ("co401gw1", "spec/co401gw1.yaml"), ("canopenia", "spec/canopenia.yaml")];
+/// The device crates whose generated code holds Kani harnesses (`serial::proofs`: one per
+/// serial command and one for the decoder; `dictionary_proofs`: a write and a read harness
+/// per mode), with their specs. A harness of theirs is named `<crate>/<path>`; a name without
+/// a crate is one of `verification/`.
+const DEVICE_CRATES: &[(&str, &str)] =
+    &[("co401memory1", "spec/co401memory1.yaml"), ("co401gw1", "spec/co401gw1.yaml"), ("cr3101", "spec/cr3101.yaml"), ("canopenia", "spec/canopenia.yaml")];
+
+/// The dictionary harnesses the generator emits per mode (codegen/gen/src/dictionary_proofs.rs).
+const DICTIONARY_HARNESSES_PER_MODE: usize = 2;
 
 /// The crate directory and the harness path Kani knows of a harness name.
 fn locate(name: &str) -> (PathBuf, &str) {
@@ -86,11 +91,13 @@ fn handwritten_count() -> usize {
         .unwrap_or(0)
 }
 
-/// The harnesses the generator emits for `spec`: one per serial command, one for the decoder.
+/// The harnesses the generator emits for `spec`: one per serial command and one for the
+/// decoder, and the dictionary's per mode.
 fn generated_count(spec: &str) -> Result<usize> {
     let text = std::fs::read_to_string(root().join(spec)).map_err(|e| format!("cannot read {spec}: {e}"))?;
     let device = coforge_spec::load_str(spec, &text).into_device().ok_or(format!("{spec} does not load: run `coforge check {spec}`"))?;
-    Ok(device.serial.map_or(0, |s| s.commands.len() + 1))
+    let modes = device.modes.len().max(1);
+    Ok(device.serial.map_or(0, |s| s.commands.len() + 1) + DICTIONARY_HARNESSES_PER_MODE * modes)
 }
 
 /// Every harness, hand-written and generated.
@@ -320,10 +327,11 @@ mod tests {
     }
 
     #[test]
-    fn the_generator_emits_a_harness_per_command_and_one_per_decoder() {
-        // CO401Memory1 has 14 serial commands, CO401GW1 16, CANopenIA 9 (`coforge check`).
+    fn the_generator_emits_a_harness_per_command_and_one_per_decoder_and_two_per_mode() {
+        // CO401Memory1 has 14 serial commands and 1 mode, CO401GW1 16 and 3, CR3101 none and
+        // 2, CANopenIA 9 and 1 (`coforge check`, `coforge info`).
         let counts: Vec<usize> = DEVICE_CRATES.iter().map(|(_, spec)| generated_count(spec).expect("spec loads")).collect();
-        assert_eq!(counts, [15, 17, 10]);
-        assert_eq!(harness_count(), handwritten_count() + 42);
+        assert_eq!(counts, [15 + 2, 17 + 6, 4, 10 + 2]);
+        assert_eq!(harness_count(), handwritten_count() + 56);
     }
 }

@@ -22,6 +22,7 @@
 
 mod app;
 mod dictionary;
+mod dictionary_proofs;
 mod emcy;
 mod entries;
 mod hardware;
@@ -77,6 +78,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
     let hardware = hardware::hardware_module(device);
     let index = index::index_module(device);
     let app = app::app_module(device, options);
+    let dictionary_proofs = dictionary_proofs::proofs_module(&modes, options);
     let stack = &options.stack;
     quote! {
         /// Device name from the spec.
@@ -95,6 +97,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
         #hardware
         #index
         #app
+        #dictionary_proofs
 
         /// The device's CANopen node: its dictionary, parameter store `S` and app objects `A`.
         pub type Node<A, S> = #stack::node::Node<Od<A>, S, { od::MAX_WRITE_SIZE }, { pdo::SLOTS }>;

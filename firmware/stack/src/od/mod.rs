@@ -19,6 +19,7 @@ pub mod abort;
 pub mod dictionary;
 pub mod entry;
 pub mod lookup;
+pub mod properties;
 pub mod side;
 
 pub use abort::SdoAbort;

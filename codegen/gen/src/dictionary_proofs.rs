@@ -1,0 +1,66 @@
+//! `dictionary_proofs` (under `cfg(kani)`): for every mode of the device, a Kani harness that
+//! any write (symbolic index, sub-index, data of up to [`DATA`] bytes, side, NMT state) keeps
+//! the dictionary's rules, and one that any read does: the properties of
+//! `coforge_stack::od::properties`, which the verification crate also runs on random inputs.
+
+use crate::modes::Modes;
+use crate::{Options, dec};
+use proc_macro2::TokenStream;
+use quote::{format_ident, quote};
+
+/// Data bytes a symbolic write carries: every fixed-size entry of up to 4 bytes, one byte
+/// more to reach "too long", and strings cut short.
+pub const DATA: usize = 5;
+
+/// The harnesses of the device's dictionary, two per mode (`cargo xtask kani` counts them so:
+/// `DICTIONARY_HARNESSES_PER_MODE` in xtask/src/kani.rs).
+pub fn proofs_module(modes: &Modes, options: &Options) -> TokenStream {
+    let stack = &options.stack;
+    let harnesses = modes.variants.iter().map(|(variant, _)| {
+        let name = variant.to_string().to_lowercase();
+        let write = format_ident!("write_keeps_the_rules_{}", name);
+        let read = format_ident!("read_keeps_the_rules_{}", name);
+        let n = dec(DATA as u64);
+        quote! {
+            /// Any write keeps the dictionary's rules (`prop_write_is_checked`).
+            #[kani::proof]
+            fn #write() {
+                let mut od = super::Od::new(super::Mode::#variant, kani::any_where(|id: &u8| (1..=127).contains(id)), #stack::od::NoAppObjects);
+                let data: [u8; #n] = kani::any();
+                let len: usize = kani::any_where(|l: &usize| *l <= #n);
+                let ctx = #stack::od::AccessContext { nmt: any_state(), can_enabled: kani::any() };
+                #stack::od::properties::prop_write_is_checked(&mut od, kani::any(), kani::any(), &data[..len], any_side(), &ctx);
+            }
+
+            /// Any read keeps the dictionary's rules (`prop_read_is_checked`).
+            #[kani::proof]
+            fn #read() {
+                let mut od = super::Od::new(super::Mode::#variant, kani::any_where(|id: &u8| (1..=127).contains(id)), #stack::od::NoAppObjects);
+                #stack::od::properties::prop_read_is_checked(&mut od, kani::any(), kani::any(), any_side());
+            }
+        }
+    });
+    quote! {
+        /// Kani harnesses over this dictionary (`cargo kani`; see verification/README.md).
+        #[cfg(kani)]
+        mod dictionary_proofs {
+            fn any_side() -> #stack::od::Side {
+                match kani::any::<u8>() % 3 {
+                    0 => #stack::od::Side::Bus,
+                    1 => #stack::od::Side::Host,
+                    _ => #stack::od::Side::Device,
+                }
+            }
+
+            fn any_state() -> #stack::od::NmtState {
+                match kani::any::<u8>() % 3 {
+                    0 => #stack::od::NmtState::PreOperational,
+                    1 => #stack::od::NmtState::Operational,
+                    _ => #stack::od::NmtState::Stopped,
+                }
+            }
+
+            #(#harnesses)*
+        }
+    }
+}
