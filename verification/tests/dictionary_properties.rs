@@ -7,43 +7,28 @@
 use coforge_stack::od::properties::{prop_read_is_checked, prop_write_is_checked};
 use coforge_stack::od::{AccessContext, NmtState, NoAppObjects, NodeDictionary, Side};
 
-/// xorshift64*: reproducible.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
-
 const CASES: usize = 60_000;
 
 fn check<D: NodeDictionary>(make: impl Fn(D::Mode) -> D, seed: u64) -> usize {
-    let mut rng = Rng(seed | 1);
+    let mut rng = fastrand::Rng::with_seed(seed);
     let mut n = 0;
     for &mode in D::MODES {
         let mut od = make(mode);
         let table = od.entries();
         for _ in 0..CASES / D::MODES.len() {
-            let run = &table[rng.below(table.len() as u64) as usize];
-            let (index, sub) = match rng.below(8) {
+            let run = &table[rng.u64(..table.len() as u64) as usize];
+            let (index, sub) = match rng.u64(..8) {
                 // Now and then anywhere: missing objects and sub-indices.
-                0 => (rng.next() as u16, rng.next() as u8),
-                1 => (run.index, run.last_sub.wrapping_add(1 + rng.below(3) as u8)),
-                _ => (run.index + rng.below(u64::from(run.copies()) + 1) as u16, run.sub + rng.below(u64::from(run.last_sub - run.sub) + 1) as u8),
+                0 => (rng.u64(..) as u16, rng.u64(..) as u8),
+                1 => (run.index, run.last_sub.wrapping_add(1 + rng.u64(..3) as u8)),
+                _ => (run.index + rng.u64(..u64::from(run.copies()) + 1) as u16, run.sub + rng.u64(..u64::from(run.last_sub - run.sub) + 1) as u8),
             };
             let size = od.entry(index, sub).map_or(4, |e| usize::from(e.size));
-            let len = (size + 2).min(32).saturating_sub(rng.below(4) as usize).min(if rng.below(4) == 0 { rng.below(33) as usize } else { usize::MAX });
-            let data: Vec<u8> = (0..len).map(|_| if rng.below(3) == 0 { 0 } else { rng.next() as u8 }).collect();
-            let side = [Side::Bus, Side::Bus, Side::Host, Side::Device][rng.below(4) as usize];
-            let nmt = [NmtState::PreOperational, NmtState::Operational, NmtState::Stopped][rng.below(3) as usize];
-            let ctx = AccessContext { nmt, can_enabled: rng.below(2) == 0 };
+            let len = (size + 2).min(32).saturating_sub(rng.u64(..4) as usize).min(if rng.u64(..4) == 0 { rng.u64(..33) as usize } else { usize::MAX });
+            let data: Vec<u8> = (0..len).map(|_| if rng.u64(..3) == 0 { 0 } else { rng.u64(..) as u8 }).collect();
+            let side = [Side::Bus, Side::Bus, Side::Host, Side::Device][rng.u64(..4) as usize];
+            let nmt = [NmtState::PreOperational, NmtState::Operational, NmtState::Stopped][rng.u64(..3) as usize];
+            let ctx = AccessContext { nmt, can_enabled: rng.u64(..2) == 0 };
             prop_write_is_checked(&mut od, index, sub, &data, side, &ctx);
             prop_read_is_checked(&mut od, index, sub, side);
             n += 1;

@@ -18,44 +18,29 @@ use card_tools::{copy_out, fsck_clean, image};
 
 const NODE: u8 = 0x20;
 
-/// xorshift64*: reproducible from its seed.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
-
 /// An object CR3101 serves from its card or clock, or one of its settings.
-fn index(rng: &mut Rng) -> u16 {
-    let file = 0x100 * rng.below(8) as u16;
-    match rng.below(6) {
-        0 => [0x2000, 0x2001, 0x2002, 0x2003, 0x2010, 0x20F5][rng.below(6) as usize],
-        1 => 0x3000 + file + rng.below(7) as u16,
-        2 => 0x3010 + file + rng.below(8) as u16,
+fn index(rng: &mut fastrand::Rng) -> u16 {
+    let file = 0x100 * rng.u64(..8) as u16;
+    match rng.u64(..6) {
+        0 => [0x2000, 0x2001, 0x2002, 0x2003, 0x2010, 0x20F5][rng.u64(..6) as usize],
+        1 => 0x3000 + file + rng.u64(..7) as u16,
+        2 => 0x3010 + file + rng.u64(..8) as u16,
         3 | 4 => 0x5000 + file,
         _ => 0x3003 + file,
     }
 }
 
 /// Values that make sense more often than uniform bytes would.
-fn data(rng: &mut Rng) -> Vec<u8> {
-    let len = [1, 2, 4, 4, 0, 3, 8, 11, 12][rng.below(9) as usize];
-    let pick = rng.below(4);
+fn data(rng: &mut fastrand::Rng) -> Vec<u8> {
+    let len = [1, 2, 4, 4, 0, 3, 8, 11, 12][rng.u64(..9) as usize];
+    let pick = rng.u64(..4);
     (0..len)
         .map(|i| match pick {
-            0 => rng.next() as u8,
-            1 => [0x01, 0x02, 0x03, 0x10, 0x55, 0][rng.below(6) as usize],
-            2 if i == 0 => rng.below(64) as u8,
+            0 => rng.u64(..) as u8,
+            1 => [0x01, 0x02, 0x03, 0x10, 0x55, 0][rng.u64(..6) as usize],
+            2 if i == 0 => rng.u64(..64) as u8,
             2 => 0,
-            _ => b"ABCDEFGH_1"[rng.below(10) as usize],
+            _ => b"ABCDEFGH_1"[rng.u64(..10) as usize],
         })
         .collect()
 }
@@ -63,27 +48,27 @@ fn data(rng: &mut Rng) -> Vec<u8> {
 fn run(seed: u64) {
     let path = image(&format!("random-{seed}"));
     let mut d = SimCr3101::new(SimBoard::new(Some(path.clone())).unwrap(), BlockStore::new(Eeprom::new(4096), 0), NODE);
-    let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let mut rng = fastrand::Rng::with_seed(seed);
     let mut now = 0_u64;
     d.start(now);
     let mut in_slot = true;
     for _ in 0..800 {
-        now += rng.below(30_000);
-        match rng.below(10) {
+        now += rng.u64(..30_000);
+        match rng.u64(..10) {
             0..=3 => {
-                let (i, sub) = (index(&mut rng), rng.below(17) as u8);
+                let (i, sub) = (index(&mut rng), rng.u64(..17) as u8);
                 let _ = Device::node_mut(&mut d).write(i, sub, &data(&mut rng), Side::Bus);
             }
             4 => {
                 let mut buf = [0; 16];
-                let _ = Device::node_mut(&mut d).read(index(&mut rng), rng.below(17) as u8, 0, &mut buf, Side::Bus);
+                let _ = Device::node_mut(&mut d).read(index(&mut rng), rng.u64(..17) as u8, 0, &mut buf, Side::Bus);
             }
             5 | 6 => {
-                let id = [0x200, 0x300, 0x400, 0x500][rng.below(4) as usize] + u16::from(NODE);
-                let payload: Vec<u8> = (0..rng.below(9)).map(|_| rng.next() as u8).collect();
+                let id = [0x200, 0x300, 0x400, 0x500][rng.u64(..4) as usize] + u16::from(NODE);
+                let payload: Vec<u8> = (0..rng.u64(..9)).map(|_| rng.u64(..) as u8).collect();
                 d.on_frame(&CanFrame::data(id, &payload).unwrap(), now);
             }
-            7 => d.on_frame(&CanFrame::data(0, &[[0x01, 0x80, 0x02, 0x82][rng.below(4) as usize], NODE]).unwrap(), now),
+            7 => d.on_frame(&CanFrame::data(0, &[[0x01, 0x80, 0x02, 0x82][rng.u64(..4) as usize], NODE]).unwrap(), now),
             8 => {
                 in_slot = !in_slot;
                 d.console(if in_slot { "card insert" } else { "card remove" }).unwrap();
