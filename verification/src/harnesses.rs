@@ -114,20 +114,28 @@ fn sdo_first_request_answers_validly() {
     prop_sdo_first_request(&request);
 }
 
-/// The mirrored EEPROM banks (`crate::banks`) on a small geometry: 2 blocks of 8 bytes, 24
-/// bytes per bank (each block is followed by its 4-byte commit record). A write of both
-/// blocks is at most 2 x 2 x 12 = 48 byte writes, so a symbolic `u32` cut step covers every
-/// cut point and "no cut".
+/// The mirrored EEPROM banks (`crate::banks`) on the geometry of the state-space search
+/// (`tests/banks_model.rs`): 2 blocks of 2 data bytes, 12 bytes per bank (each block is
+/// followed by its 4-byte commit record). 2 blocks: a write can span blocks, so the commit
+/// order and a cut between blocks are covered; 2 bytes: a write can change part of a block,
+/// and a cut can fall between two data bytes. The write protocol (mark, changed data bytes,
+/// CRC, begin, end) and the record are the same for any block size, and every cut point is a
+/// single byte write. A write of both blocks is at most 2 x 2 x 7 = 28 byte writes, so a
+/// symbolic `u32` cut step covers every cut point and "no cut".
 mod mirrored_banks {
     use crate::banks::*;
 
-    type Devices<'p> = [CutEeprom<'p, 24>; 2];
+    const BLOCKS: usize = 2;
+    const BLOCK: usize = KANI_MAX_WRITE;
+    const N: usize = BLOCKS * slot_size(BLOCK);
+
+    type Devices<'p> = [CutEeprom<'p, N>; 2];
 
     /// Both banks holding any data, each block committed with any sequence number.
     fn any_committed(power: &Power) -> Devices<'_> {
-        let data: [[u8; 8]; 2] = kani::any();
-        let seqs: [u8; 2] = kani::any();
-        committed_devices::<24, 2, 8>(power, &data, &seqs)
+        let data: [[u8; BLOCK]; BLOCKS] = kani::any();
+        let seqs: [u8; BLOCKS] = kani::any();
+        committed_devices::<N, BLOCKS, BLOCK>(power, &data, &seqs)
     }
 
     fn any_cut() -> CutByte {
@@ -139,71 +147,71 @@ mod mirrored_banks {
         [CutEeprom::new(power, kani::any()), CutEeprom::new(power, kani::any())]
     }
 
-    /// (a) Any write (0..=16 bytes at 0..=17, out of range included), cut at any byte write
+    /// (a) Any write (0..=5 bytes at 0..=5, out of range included), cut at any byte write
     /// with the byte old, new or any garbage, then a reboot: every block old or new.
     #[kani::proof]
-    #[kani::unwind(26)]
+    #[kani::unwind(13)]
     fn banks_write_cut_leaves_old_or_new() {
         let power = Power::new();
         let devices = any_committed(&power);
-        let data: [u8; 16] = kani::any();
+        let data: [u8; BLOCKS * BLOCK + 1] = kani::any();
         let addr: usize = kani::any();
         let len: usize = kani::any();
-        kani::assume(addr <= 17 && len <= data.len());
-        prop_write_cut::<24, 2, 8>(devices, addr, &data[..len], kani::any(), any_cut());
+        kani::assume(addr <= BLOCKS * BLOCK + 1 && len <= data.len());
+        prop_write_cut::<N, BLOCKS, BLOCK>(devices, addr, &data[..len], kani::any(), any_cut());
     }
 
     /// (b) Any contents mounted twice: the second mount writes nothing and finds nothing new.
     #[kani::proof]
-    #[kani::unwind(26)]
+    #[kani::unwind(13)]
     fn banks_recovery_is_idempotent_for_any_contents() {
         let power = Power::new();
-        prop_recovery_idempotent::<24, 2, 8>(any_devices(&power));
+        prop_recovery_idempotent::<N, BLOCKS, BLOCK>(any_devices(&power));
     }
 
     /// (b) Any contents, the recovery cut at any byte write with any byte left: the reboot
     /// ends with the contents and images of an uncut recovery.
     #[kani::proof]
-    #[kani::unwind(26)]
+    #[kani::unwind(13)]
     fn banks_recovery_cut_at_any_byte_for_any_contents() {
         let power = Power::new();
-        prop_recovery_cut::<24, 2, 8>(any_devices(&power), kani::any(), any_cut());
+        prop_recovery_cut::<N, BLOCKS, BLOCK>(any_devices(&power), kani::any(), any_cut());
     }
 
     /// (b) A torn write (any data, any cut) then a recovery cut at any byte write.
     #[kani::proof]
-    #[kani::unwind(26)]
+    #[kani::unwind(13)]
     fn banks_recovery_cut_at_any_byte_after_a_torn_write() {
         let power = Power::new();
-        let mut banks = Banks::<24, 2, 8>::mount(any_committed(&power));
-        let data: [u8; 8] = kani::any();
+        let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(any_committed(&power));
+        let data: [u8; BLOCK] = kani::any();
         let addr: usize = kani::any();
-        kani::assume(addr <= 8);
+        kani::assume(addr <= BLOCK);
         power.arm(kani::any(), any_cut());
         let _ = banks.write(addr, &data);
         power.restore_power();
-        prop_recovery_cut::<24, 2, 8>(banks.into_banks(), kani::any(), any_cut());
+        prop_recovery_cut::<N, BLOCKS, BLOCK>(banks.into_banks(), kani::any(), any_cut());
     }
 
     /// (b) The format of blank (erased) banks, cut at any byte write.
     #[kani::proof]
-    #[kani::unwind(26)]
+    #[kani::unwind(13)]
     fn banks_format_cut_at_any_byte() {
         let power = Power::new();
         let devices = [CutEeprom::erased(&power), CutEeprom::erased(&power)];
-        prop_recovery_cut::<24, 2, 8>(devices, kani::any(), any_cut());
+        prop_recovery_cut::<N, BLOCKS, BLOCK>(devices, kani::any(), any_cut());
     }
 
     /// (c) Any byte of either bank set to any other value is found (reboot, read or
     /// check_block) and repaired from the other bank.
     #[kani::proof]
-    #[kani::unwind(26)]
+    #[kani::unwind(13)]
     fn banks_single_corruption_is_found_and_repaired() {
         let power = Power::new();
-        let banks = Banks::<24, 2, 8>::mount(any_committed(&power));
+        let banks = Banks::<N, BLOCKS, BLOCK>::mount(any_committed(&power));
         let bank: usize = kani::any();
         let pos: usize = kani::any();
-        kani::assume(bank < 2 && pos < 24);
+        kani::assume(bank < 2 && pos < N);
         let value: u8 = kani::any();
         kani::assume(value != banks.banks()[bank].as_bytes()[pos]);
         prop_single_corruption(banks, bank, pos, value, Detect::select(kani::any()));
@@ -213,39 +221,40 @@ mod mirrored_banks {
     /// never read as data, and a write restarts it. Precondition of a reboot: the block is
     /// not what a format writes (zeros committed as sequence 0).
     #[kani::proof]
-    #[kani::unwind(26)]
+    #[kani::unwind(13)]
     fn banks_double_corruption_is_lost() {
         let power = Power::new();
-        let data: [[u8; 8]; 2] = kani::any();
-        let seqs: [u8; 2] = kani::any();
+        let data: [[u8; BLOCK]; BLOCKS] = kani::any();
+        let seqs: [u8; BLOCKS] = kani::any();
         let block: usize = kani::any();
-        kani::assume(block < 2);
-        kani::assume(data[block] != [0; 8] || seqs[block] != 0);
-        let banks = Banks::<24, 2, 8>::mount(committed_devices::<24, 2, 8>(&power, &data, &seqs));
+        kani::assume(block < BLOCKS);
+        kani::assume(data[block] != [0; BLOCK] || seqs[block] != 0);
+        let banks = Banks::<N, BLOCKS, BLOCK>::mount(committed_devices::<N, BLOCKS, BLOCK>(&power, &data, &seqs));
         let offsets: [usize; 2] = kani::any();
         let values: [u8; 2] = kani::any();
-        kani::assume(offsets[0] < 12 && offsets[1] < 12);
-        kani::assume(values[0] != banks.banks()[0].as_bytes()[block * 12 + offsets[0]]);
-        kani::assume(values[1] != banks.banks()[1].as_bytes()[block * 12 + offsets[1]]);
+        let slot = slot_size(BLOCK);
+        kani::assume(offsets[0] < slot && offsets[1] < slot);
+        kani::assume(values[0] != banks.banks()[0].as_bytes()[block * slot + offsets[0]]);
+        kani::assume(values[1] != banks.banks()[1].as_bytes()[block * slot + offsets[1]]);
         prop_double_corruption(banks, block, offsets, values, Detect::select(kani::any()));
     }
 
     /// (d) The bank sums equal a recomputation after any 3 operations (writes, cut writes,
     /// corruption + check_block, reads, checks, scrubs, reboots).
     #[kani::proof]
-    #[kani::unwind(26)]
+    #[kani::unwind(13)]
     fn banks_checksum_matches_after_3_operations() {
         let power = Power::new();
         let ops: [[u8; 6]; 3] = kani::any();
-        prop_checksum_after_ops::<24, 2, 8>(any_committed(&power), &ops);
+        prop_checksum_after_ops::<N, BLOCKS, BLOCK>(any_committed(&power), &ops);
     }
 
     /// (e) Any contents, either bank not answering, any 2 operations: no panic.
     #[kani::proof]
-    #[kani::unwind(26)]
+    #[kani::unwind(13)]
     fn banks_are_total_for_any_contents() {
         let power = Power::new();
         let ops: [[u8; 6]; 2] = kani::any();
-        prop_banks_total::<24, 2, 8>(any_devices(&power), kani::any(), &ops);
+        prop_banks_total::<N, BLOCKS, BLOCK>(any_devices(&power), kani::any(), &ops);
     }
 }

@@ -154,7 +154,14 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
 
     /// The 32-bit sum of bank `bank`'s data bytes (5C00h), without reading the EEPROM.
     pub fn checksum(&self, bank: usize) -> u32 {
-        self.block_sums.get(bank).map_or(0, |sums| sums.iter().map(|&s| u32::from(s)).sum())
+        let Some(sums) = self.block_sums.get(bank) else { return 0 };
+        // Loops, not `fold` or `sum` over slices: Kani (CBMC 6.6) never reduces those to
+        // constants, so a proof would treat every sum as unknown.
+        let mut total = 0;
+        for &s in sums {
+            total += u32::from(s);
+        }
+        total
     }
 
     /// Neither bank holds a valid copy of `block`.
@@ -208,7 +215,7 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
     fn chunks(addr: usize, len: usize) -> Result<impl Iterator<Item = (usize, usize, usize)>, Error> {
         let end = addr.checked_add(len).filter(|&e| e <= Self::DATA_SIZE).ok_or(Error::OutOfRange)?;
         let mut pos = addr;
-        Ok(core::iter::from_fn(move || {
+        let pieces = core::iter::from_fn(move || {
             if pos >= end || BLOCK == 0 {
                 return None;
             }
@@ -216,7 +223,11 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
             let n = (BLOCK - at).min(end - pos);
             pos += n;
             Some((block, at, n))
-        }))
+        });
+        // A range inside the data area touches each block at most once, so there are at most
+        // BLOCKS pieces and `take` changes nothing; it gives the loops over the pieces a
+        // constant bound, which Kani (CBMC) needs to stop unrolling them at BLOCKS.
+        Ok(pieces.take(BLOCKS))
     }
 
     fn read_in_block(&mut self, block: usize, at: usize, dst: &mut [u8]) -> Result<(), Error> {
@@ -288,8 +299,11 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
                 Ok(Settled { data: w.data, seq, mirrored })
             }
             Verdict::Lost => {
-                for (s, c) in self.status.iter_mut().zip(copies) {
-                    if c.state == CopyState::Invalid {
+                // Indexed, not `zip`: Kani cannot bound a `zip` loop by its length.
+                for (bank, c) in copies.iter().enumerate() {
+                    if c.state == CopyState::Invalid
+                        && let Some(s) = self.status.get_mut(bank)
+                    {
                         s.set(BankStatus::CHECKSUM_ERROR);
                     }
                 }
@@ -386,7 +400,10 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
     fn set_block_sum(&mut self, bank: usize, block: usize, data: &[u8; BLOCK]) {
         if let Some(sum) = self.block_sums.get_mut(bank).and_then(|sums| sums.get_mut(block)) {
             // At most 255 * BLOCK; blocks beyond 257 bytes would need a wider sum.
-            *sum = data.iter().fold(0_u16, |s, &b| s.wrapping_add(u16::from(b)));
+            *sum = 0;
+            for &b in data {
+                *sum = sum.wrapping_add(u16::from(b));
+            }
         }
     }
 
