@@ -28,10 +28,15 @@ pub fn find_run(entries: &[EntryInfo], index: u16, sub: u8) -> Result<usize, Sdo
         Some(e) if e.covers_index(index) => e.index,
         _ => return Err(SdoAbort::NoObject),
     };
-    // The sub-index: the object's runs end at `last` and are few, so a scan back is quicker
-    // than a second search.
-    let runs = entries.get(..listed).unwrap_or_default().iter().enumerate().rev().take_while(|(_, e)| e.index == first);
-    runs.filter(|(_, e)| e.covers(sub)).map(|(i, _)| i).next().ok_or(SdoAbort::NoSubIndex)
+    // The sub-index: only the object's last run starting at or before `sub` can cover it. A
+    // second binary search rather than a scan back over the object's runs: its steps depend
+    // on the table's length alone, so Kani unrolls it a fixed number of times even for a
+    // symbolic index.
+    let run = entries.partition_point(|e| (e.index, e.sub) <= (first, sub)).checked_sub(1).ok_or(SdoAbort::NoSubIndex)?;
+    match entries.get(run) {
+        Some(e) if e.index == first && e.covers(sub) => Ok(run),
+        _ => Err(SdoAbort::NoSubIndex),
+    }
 }
 
 #[cfg(test)]
