@@ -5,6 +5,7 @@
 
 use crate::modes::Modes;
 use crate::{Options, dec};
+use coforge_spec::model::Device;
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
@@ -12,10 +13,24 @@ use quote::{format_ident, quote};
 /// more to reach "too long", and strings cut short.
 pub const DATA: usize = 5;
 
+/// The value buffer of `coforge_stack::od::properties` (`BUF`): the longest loop of a constant
+/// length the harnesses reach.
+const READ_BUF: usize = 16;
+
+/// The harnesses' loop bound: Kani unrolls every loop up to it and proves (unwinding
+/// assertions) that none runs longer. The loops whose length depends on the symbolic entry are
+/// the search of its allowed values, the data bytes and the table's binary searches (fewer
+/// steps than the read buffer has bytes for any table of up to 65,536 runs).
+fn unwind(device: &Device) -> usize {
+    let longest_values = device.objects.iter().flat_map(|o| &o.entries).filter_map(|e| e.values.as_ref().map(Vec::len)).max().unwrap_or(0);
+    READ_BUF.max(longest_values).max(DATA) + 1
+}
+
 /// The harnesses of the device's dictionary, two per mode (`cargo xtask kani` counts them so:
 /// `DICTIONARY_HARNESSES_PER_MODE` in xtask/src/kani.rs).
-pub fn proofs_module(modes: &Modes, options: &Options) -> TokenStream {
+pub fn proofs_module(device: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let stack = &options.stack;
+    let unwind = dec(unwind(device) as u64);
     let harnesses = modes.variants.iter().map(|(variant, _)| {
         let name = variant.to_string().to_lowercase();
         let write = format_ident!("write_keeps_the_rules_{}", name);
@@ -24,6 +39,7 @@ pub fn proofs_module(modes: &Modes, options: &Options) -> TokenStream {
         quote! {
             /// Any write keeps the dictionary's rules (`prop_write_is_checked`).
             #[kani::proof]
+            #[kani::unwind(#unwind)]
             fn #write() {
                 let mut od = super::Od::new(super::Mode::#variant, kani::any_where(|id: &u8| (1..=127).contains(id)), #stack::od::NoAppObjects);
                 let data: [u8; #n] = kani::any();
@@ -34,6 +50,7 @@ pub fn proofs_module(modes: &Modes, options: &Options) -> TokenStream {
 
             /// Any read keeps the dictionary's rules (`prop_read_is_checked`).
             #[kani::proof]
+            #[kani::unwind(#unwind)]
             fn #read() {
                 let mut od = super::Od::new(super::Mode::#variant, kani::any_where(|id: &u8| (1..=127).contains(id)), #stack::od::NoAppObjects);
                 #stack::od::properties::prop_read_is_checked(&mut od, kani::any(), kani::any(), any_side());

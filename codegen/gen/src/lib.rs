@@ -78,7 +78,7 @@ pub fn generate(device: &Device, options: &Options) -> TokenStream {
     let hardware = hardware::hardware_module(device);
     let index = index::index_module(device);
     let app = app::app_module(device, options);
-    let dictionary_proofs = dictionary_proofs::proofs_module(&modes, options);
+    let dictionary_proofs = dictionary_proofs::proofs_module(device, &modes, options);
     let stack = &options.stack;
     quote! {
         /// Device name from the spec.

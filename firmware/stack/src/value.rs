@@ -1,6 +1,6 @@
 //! How typed dictionary fields are read and written as little-endian bytes.
 
-use crate::od::entry::Int;
+use crate::od::entry::{Int, le_u64};
 use crate::od::{EntryInfo, ReadLen, SdoAbort, read_slice};
 
 /// A value stored in a dictionary field. `write` gets data that already passed the access,
@@ -17,7 +17,7 @@ pub trait OdValue {
 /// then only truncates.
 fn int_bits(entry: &EntryInfo, data: &[u8], width: usize, signed: bool) -> Result<u64, SdoAbort> {
     if data.len() == width {
-        return Ok(data.iter().rev().fold(0_u64, |acc, &b| acc << 8 | u64::from(b)));
+        return le_u64(data).ok_or(SdoAbort::LengthMismatch);
     }
     // The field's range: 0..=2^bits - 1, or -2^(bits - 1)..=2^(bits - 1) - 1.
     let unused = 64_u32.saturating_sub(8 * width as u32);

@@ -326,6 +326,15 @@ impl EntryInfo {
     }
 }
 
+/// The unsigned value of up to 8 little-endian bytes; `None` for more. Through a fixed
+/// 8-byte buffer rather than a fold over the slice: Kani (CBMC) cannot bound a loop over a
+/// slice whose length is symbolic, such as data for an entry chosen by a symbolic index.
+pub(crate) fn le_u64(data: &[u8]) -> Option<u64> {
+    let mut bytes = [0; 8];
+    bytes.get_mut(..data.len())?.copy_from_slice(data);
+    Some(u64::from_le_bytes(bytes))
+}
+
 /// The value of a little-endian integer entry, as its type's signedness says: compared with
 /// the `i64` limits without 128-bit arithmetic, which is costly on a Cortex-M0.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -350,7 +359,7 @@ impl Int {
         if data.len() != bytes {
             return None;
         }
-        let raw = data.iter().rev().fold(0_u64, |acc, &b| acc << 8 | u64::from(b));
+        let raw = le_u64(data)?;
         // Signed types: sign-extend from the type's width by shifting its sign bit to bit 63.
         let unused = 64 - bits;
         Some(if signed { Int::Signed(((raw << unused) as i64) >> unused) } else { Int::Unsigned(raw) })
