@@ -202,11 +202,11 @@ mod mirrored_banks {
         prop_recovery_cut::<N, BLOCKS, BLOCK>(devices, kani::any(), any_cut());
     }
 
-    /// (c) Any byte of either bank set to any other value is found (reboot, read or
-    /// check_block) and repaired from the other bank.
-    #[kani::proof]
-    #[kani::unwind(13)]
-    fn banks_single_corruption_is_found_and_repaired() {
+    /// (c) Any byte of either bank set to any other value is found `via` (a reboot, a read or
+    /// `check_block`) and repaired from the other bank. One harness per way of looking: each
+    /// is a third of the paths, and together they cover what one harness with a symbolic
+    /// `Detect` would.
+    fn single_corruption(via: Detect) {
         let power = Power::new();
         let banks = Banks::<N, BLOCKS, BLOCK>::mount(any_committed(&power));
         let bank: usize = kani::any();
@@ -214,15 +214,32 @@ mod mirrored_banks {
         kani::assume(bank < 2 && pos < N);
         let value: u8 = kani::any();
         kani::assume(value != banks.banks()[bank].as_bytes()[pos]);
-        prop_single_corruption(banks, bank, pos, value, Detect::select(kani::any()));
+        prop_single_corruption(banks, bank, pos, value, via);
+    }
+
+    #[kani::proof]
+    #[kani::unwind(13)]
+    fn banks_single_corruption_is_found_by_a_reboot_and_repaired() {
+        single_corruption(Detect::Mount);
+    }
+
+    #[kani::proof]
+    #[kani::unwind(13)]
+    fn banks_single_corruption_is_found_by_a_read_and_repaired() {
+        single_corruption(Detect::Read);
+    }
+
+    #[kani::proof]
+    #[kani::unwind(13)]
+    fn banks_single_corruption_is_found_by_check_block_and_repaired() {
+        single_corruption(Detect::CheckBlock);
     }
 
     /// (c) One block corrupted in both banks (any byte of each, any other values) is lost,
     /// never read as data, and a write restarts it. Precondition of a reboot: the block is
-    /// not what a format writes (zeros committed as sequence 0).
-    #[kani::proof]
-    #[kani::unwind(13)]
-    fn banks_double_corruption_is_lost() {
+    /// not what a format writes (zeros committed as sequence 0). One harness per way of
+    /// looking, as for a single corruption.
+    fn double_corruption(via: Detect) {
         let power = Power::new();
         let data: [[u8; BLOCK]; BLOCKS] = kani::any();
         let seqs: [u8; BLOCKS] = kani::any();
@@ -236,7 +253,25 @@ mod mirrored_banks {
         kani::assume(offsets[0] < slot && offsets[1] < slot);
         kani::assume(values[0] != banks.banks()[0].as_bytes()[block * slot + offsets[0]]);
         kani::assume(values[1] != banks.banks()[1].as_bytes()[block * slot + offsets[1]]);
-        prop_double_corruption(banks, block, offsets, values, Detect::select(kani::any()));
+        prop_double_corruption(banks, block, offsets, values, via);
+    }
+
+    #[kani::proof]
+    #[kani::unwind(13)]
+    fn banks_double_corruption_found_by_a_reboot_is_lost() {
+        double_corruption(Detect::Mount);
+    }
+
+    #[kani::proof]
+    #[kani::unwind(13)]
+    fn banks_double_corruption_found_by_a_read_is_lost() {
+        double_corruption(Detect::Read);
+    }
+
+    #[kani::proof]
+    #[kani::unwind(13)]
+    fn banks_double_corruption_found_by_check_block_is_lost() {
+        double_corruption(Detect::CheckBlock);
     }
 
     /// (d) The bank sums equal a recomputation after any 3 operations (writes, cut writes,
