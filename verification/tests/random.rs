@@ -44,8 +44,8 @@ proptest! {
     }
 }
 
-/// The mirrored banks on the geometry of the Kani harnesses (2 blocks of 8 bytes, 24 bytes per
-/// bank), with structured contents: committed banks, erased or random ones, then a few bytes
+/// The mirrored banks on 2 blocks of 8 bytes (24 bytes per bank; the Kani harnesses use 2
+/// blocks of 2 bytes, which `tests/banks_model.rs` searches exhaustively), with structured contents: committed banks, erased or random ones, then a few bytes
 /// of either bank overwritten.
 mod banks_small {
     use coforge_verification::banks::*;
