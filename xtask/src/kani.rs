@@ -54,8 +54,7 @@ const CI_BUDGET_MINUTES: u64 = 20;
 #[derive(Debug, Clone, PartialEq, Eq)]
 enum Outcome {
     Verified,
-    /// For a batch, the harnesses that failed (from Kani's summary).
-    Failed(String),
+    Failed,
     /// Stopped at its time limit.
     Timeout,
     /// Not started: the budget was spent.
@@ -65,10 +64,7 @@ enum Outcome {
 }
 
 struct Run {
-    /// The harness, or for a batch the harnesses' common prefix and `*`.
     name: String,
-    /// How many harnesses the run covers (more than 1 for a batch).
-    harnesses: usize,
     outcome: Outcome,
     secs: f64,
     peak_kb: Option<u64>,
@@ -86,35 +82,8 @@ pub fn installed() -> bool {
 const DEVICE_CRATES: &[(&str, &str)] =
     &[("co401memory1", "spec/co401memory1.yaml"), ("co401gw1", "spec/co401gw1.yaml"), ("cr3101", "spec/cr3101.yaml"), ("canopenia", "spec/canopenia.yaml")];
 
-/// The generated write harnesses of one object each (`dictionary_proofs::write_keeps_the_rules_
-/// <mode>_<index>`, and `_missing`): small, and many (one per object per mode), so those of
-/// one crate and mode run in one `cargo kani` (a batch), which compiles the crate once.
-const BATCHED: &str = "dictionary_proofs::write_keeps_the_rules_";
-
-/// A `cargo kani` run: one harness, or a [`BATCHED`] batch of one crate and mode.
-#[derive(Debug, Clone, PartialEq, Eq)]
-struct Task {
-    /// The harness name, or for a batch the common prefix and `*`.
-    name: String,
-    harnesses: Vec<String>,
-}
-
-/// `names` as tasks, in their order: a batch where its first harness was.
-fn tasks(names: &[String]) -> Vec<Task> {
-    let mut out: Vec<Task> = Vec::new();
-    for name in names {
-        // `<crate>/dictionary_proofs::write_keeps_the_rules_<mode>_`: up to the last `_`.
-        let batch = name.contains(BATCHED).then(|| name.rsplit_once('_').map(|(prefix, _)| format!("{prefix}_*"))).flatten();
-        match batch {
-            Some(batch) => match out.iter_mut().find(|t| t.name == batch) {
-                Some(task) => task.harnesses.push(name.clone()),
-                None => out.push(Task { name: batch, harnesses: vec![name.clone()] }),
-            },
-            None => out.push(Task { name: name.clone(), harnesses: vec![name.clone()] }),
-        }
-    }
-    out
-}
+/// The dictionary harnesses the generator emits per mode (codegen/gen/src/dictionary_proofs.rs).
+const DICTIONARY_HARNESSES_PER_MODE: usize = 2;
 
 /// The crate directory and the harness path Kani knows of a harness name.
 fn locate(name: &str) -> (PathBuf, &str) {
@@ -134,12 +103,12 @@ fn handwritten_count() -> usize {
 }
 
 /// The harnesses the generator emits for `spec`: one per serial command and one for the
-/// decoder, and the dictionary's (per mode: one write harness per object, one for missing
-/// entries, one read harness).
+/// decoder, and the dictionary's per mode.
 fn generated_count(spec: &str) -> Result<usize> {
     let text = std::fs::read_to_string(root().join(spec)).map_err(|e| format!("cannot read {spec}: {e}"))?;
     let device = coforge_spec::load_str(spec, &text).into_device().ok_or(format!("{spec} does not load: run `coforge check {spec}`"))?;
-    Ok(device.serial.as_ref().map_or(0, |s| s.commands.len() + 1) + coforge_codegen::dictionary_harness_count(&device))
+    let modes = device.modes.len().max(1);
+    Ok(device.serial.map_or(0, |s| s.commands.len() + 1) + DICTIONARY_HARNESSES_PER_MODE * modes)
 }
 
 /// Every harness, hand-written and generated.
@@ -240,22 +209,19 @@ fn report(runs: &[Run], total: usize) -> Result {
     for r in runs {
         let outcome = match &r.outcome {
             Outcome::Verified => "VERIFIED".to_string(),
-            Outcome::Failed(which) if which.is_empty() => "**FAILED**".to_string(),
-            Outcome::Failed(which) => format!("**FAILED**: {which}"),
+            Outcome::Failed => "**FAILED**".to_string(),
             Outcome::Timeout => "**timeout**".to_string(),
             Outcome::NotRun => "not run (budget spent)".to_string(),
             Outcome::Error(e) => format!("**error**: {e}"),
         };
         let mem = r.peak_kb.map_or("—".to_string(), |kb| format!("{} MB", kb / 1024));
-        let name = if r.harnesses > 1 { format!("`{}` ({} harnesses)", r.name, r.harnesses) } else { format!("`{}`", r.name) };
-        println!("| {name} | {outcome} | {:.1} s | {mem} |", r.secs);
+        println!("| `{}` | {outcome} | {:.1} s | {mem} |", r.name, r.secs);
     }
-    let harnesses = |outcome: &dyn Fn(&Outcome) -> bool| runs.iter().filter(|r| outcome(&r.outcome)).map(|r| r.harnesses).sum::<usize>();
-    let verified = harnesses(&|o| *o == Outcome::Verified);
-    let not_run = harnesses(&|o| *o == Outcome::NotRun);
+    let verified = runs.iter().filter(|r| r.outcome == Outcome::Verified).count();
+    let not_run = runs.iter().filter(|r| r.outcome == Outcome::NotRun).count();
     println!(
         "xtask: Kani {KANI_VERSION}: {verified} of {} harnesses run here VERIFIED, {not_run} not run for the budget; {} of the {total} harnesses are in the slow set (`cargo xtask kani --all`)",
-        harnesses(&|_| true),
+        runs.len(),
         total.saturating_sub(FAST.len())
     );
     let bad: Vec<&str> = runs.iter().filter(|r| !matches!(r.outcome, Outcome::Verified | Outcome::NotRun)).map(|r| r.name.as_str()).collect();
@@ -264,7 +230,7 @@ fn report(runs: &[Run], total: usize) -> Result {
 
 /// A running harness.
 struct Job {
-    task: Task,
+    name: String,
     child: Child,
     started: Instant,
     log: PathBuf,
@@ -272,22 +238,20 @@ struct Job {
 }
 
 /// Runs `names` two at a time (each worker with a target directory of its own: two `cargo
-/// kani` in one directory race on its goto files), each within `limit` (a batch within
-/// `limit` per harness), none started after `budget` has passed; a harness that
-/// [`runs_alone`] has the machine to itself.
+/// kani` in one directory race on its goto files), each within `limit`, none started after
+/// `budget` has passed; a harness that [`runs_alone`] has the machine to itself.
 fn run_all(names: &[String], limit: Duration, budget: Duration) -> Result<Vec<Run>> {
     let out = root().join("target/kani-runs");
     std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let began = Instant::now();
-    let tasks = tasks(names);
-    let mut queue = tasks.iter().peekable();
+    let mut queue = names.iter().peekable();
     let mut workers: [Option<Job>; 2] = [None, None];
     let mut runs = Vec::new();
     loop {
         for slot in workers.iter_mut() {
             let Some(job) = slot else { continue };
             let done = job.child.try_wait().map_err(|e| e.to_string())?.is_some();
-            if !done && job.started.elapsed() < limit * job.task.harnesses.len() as u32 {
+            if !done && job.started.elapsed() < limit {
                 continue;
             }
             if !done {
@@ -299,18 +263,18 @@ fn run_all(names: &[String], limit: Duration, budget: Duration) -> Result<Vec<Ru
             *slot = None;
         }
         for w in 0..workers.len() {
-            let Some(task) = queue.peek().copied() else { break };
+            let Some(name) = queue.peek().copied() else { break };
             if began.elapsed() >= budget {
-                runs.push(Run { name: task.name.clone(), harnesses: task.harnesses.len(), outcome: Outcome::NotRun, secs: 0.0, peak_kb: None });
+                runs.push(Run { name: name.clone(), outcome: Outcome::NotRun, secs: 0.0, peak_kb: None });
                 queue.next();
                 continue;
             }
             let busy: Vec<&Job> = workers.iter().flatten().collect();
-            if workers[w].is_some() || (!busy.is_empty() && (runs_alone(&task.name) || busy.iter().any(|j| runs_alone(&j.task.name)))) {
+            if workers[w].is_some() || (!busy.is_empty() && (runs_alone(name) || busy.iter().any(|j| runs_alone(&j.name)))) {
                 continue;
             }
             queue.next();
-            workers[w] = Some(start(task, w, &out)?);
+            workers[w] = Some(start(name, w, &out)?);
         }
         if workers.iter().all(Option::is_none) && queue.peek().is_none() {
             break;
@@ -318,7 +282,7 @@ fn run_all(names: &[String], limit: Duration, budget: Duration) -> Result<Vec<Ru
         std::thread::sleep(Duration::from_millis(200));
     }
     // In the order asked.
-    runs.sort_by_key(|r| tasks.iter().position(|t| t.name == r.name));
+    runs.sort_by_key(|r| names.iter().position(|n| *n == r.name));
     Ok(runs)
 }
 
@@ -327,11 +291,10 @@ fn runs_alone(name: &str) -> bool {
     ALONE.iter().any(|part| name.contains(part))
 }
 
-/// Starts `cargo kani` on `task`'s harnesses in worker `w`'s target directory, its output and
-/// peak memory into `out`.
-fn start(task: &Task, w: usize, out: &std::path::Path) -> Result<Job> {
-    let name = task.name.as_str();
-    let safe = name.replace("::", "-").replace('/', "-").replace('*', "all");
+/// Starts `cargo kani` on harness `name` in worker `w`'s target directory, its output and peak
+/// memory into `out`.
+fn start(name: &str, w: usize, out: &std::path::Path) -> Result<Job> {
+    let safe = name.replace("::", "-").replace('/', "-");
     let log = out.join(format!("{safe}.log"));
     let time_file = out.join(format!("{safe}.time"));
     let time = std::path::Path::new("/usr/bin/time").exists();
@@ -339,12 +302,8 @@ fn start(task: &Task, w: usize, out: &std::path::Path) -> Result<Job> {
     if time {
         cmd.args(["-f", "%M", "-o"]).arg(&time_file).arg("cargo");
     }
-    // A batch's harnesses are all in one crate.
-    let (dir, _) = locate(name);
-    cmd.args(["kani", "--exact", "--target-dir"]).arg(root().join(format!("target/kani-w{w}"))).current_dir(dir).process_group(0);
-    for harness in &task.harnesses {
-        cmd.args(["--harness", locate(harness).1]);
-    }
+    let (dir, path) = locate(name);
+    cmd.args(["kani", "--harness", path, "--exact", "--target-dir"]).arg(root().join(format!("target/kani-w{w}"))).current_dir(dir).process_group(0);
     if WITHOUT_REACH_CHECKS.iter().any(|prefix| name.starts_with(prefix)) {
         cmd.arg("--no-assertion-reach-checks");
     }
@@ -352,7 +311,7 @@ fn start(task: &Task, w: usize, out: &std::path::Path) -> Result<Job> {
     let err = file.try_clone().map_err(|e| e.to_string())?;
     let child = cmd.stdout(file).stderr(err).spawn().map_err(|e| format!("cannot run cargo kani: {e}"))?;
     println!("xtask: kani {name}");
-    Ok(Job { task: task.clone(), child, started: Instant::now(), log, time_file })
+    Ok(Job { name: name.to_string(), child, started: Instant::now(), log, time_file })
 }
 
 fn finish(job: &Job, done: bool) -> Run {
@@ -361,17 +320,15 @@ fn finish(job: &Job, done: bool) -> Run {
     let peak_kb = std::fs::read_to_string(&job.time_file).ok().and_then(|t| t.lines().last()?.trim().parse().ok());
     let outcome = if !done {
         Outcome::Timeout
-    } else if log.contains("VERIFICATION:- FAILED") {
-        // A batch's summary names the harnesses that failed.
-        let failed: Vec<&str> = log.lines().filter_map(|l| l.trim().strip_prefix("Verification failed for - ")).collect();
-        Outcome::Failed(failed.join(", "))
-    } else if log.matches("VERIFICATION:- SUCCESSFUL").count() == job.task.harnesses.len() {
+    } else if log.contains("VERIFICATION:- SUCCESSFUL") {
         Outcome::Verified
+    } else if log.contains("VERIFICATION:- FAILED") {
+        Outcome::Failed
     } else {
         let last = log.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("no output").trim().to_string();
         Outcome::Error(format!("{last} (log: {})", job.log.display()))
     };
-    Run { name: job.task.name.clone(), harnesses: job.task.harnesses.len(), outcome, secs, peak_kb }
+    Run { name: job.name.clone(), outcome, secs, peak_kb }
 }
 
 #[cfg(test)]
@@ -404,37 +361,11 @@ mod tests {
     }
 
     #[test]
-    fn the_generator_emits_a_harness_per_command_and_decoder_and_per_object_and_mode() {
-        // Serial: CO401Memory1 has 14 commands, CO401GW1 16, CR3101 none, CANopenIA 9, each
-        // with its decoder. Dictionary, per mode: a write harness per object its table lists,
-        // one for missing entries and a read harness. Objects listed: CO401Memory1 41 (5000h..
-        // 503Fh in two runs of copies), CO401GW1 65 mixed and 52 in each digital mode, CR3101
-        // 92 logging and 94 PDO read, CANopenIA 45 (`codegen/gen/tests/snapshots`).
+    fn the_generator_emits_a_harness_per_command_and_one_per_decoder_and_two_per_mode() {
+        // CO401Memory1 has 14 serial commands and 1 mode, CO401GW1 16 and 3, CR3101 none and
+        // 2, CANopenIA 9 and 1 (`coforge check`, `coforge info`).
         let counts: Vec<usize> = DEVICE_CRATES.iter().map(|(_, spec)| generated_count(spec).expect("spec loads")).collect();
-        assert_eq!(counts, [15 + 43, 17 + 67 + 54 + 54, 94 + 96, 10 + 47]);
-        assert_eq!(harness_count(), handwritten_count() + 58 + 192 + 190 + 57);
-    }
-
-    #[test]
-    fn the_write_harnesses_of_a_crate_and_mode_run_as_one_batch() {
-        let names: Vec<String> = [
-            "harnesses::nibble_round_trip",
-            "co401gw1/dictionary_proofs::write_keeps_the_rules_mixed_1000",
-            "co401gw1/dictionary_proofs::write_keeps_the_rules_digital_1000",
-            "co401gw1/dictionary_proofs::write_keeps_the_rules_mixed_missing",
-            "co401gw1/dictionary_proofs::read_keeps_the_rules_mixed",
-            "co401gw1/dictionary_proofs::write_keeps_the_rules_digitalalt_1000",
-        ]
-        .map(String::from)
-        .to_vec();
-        let got: Vec<(String, usize)> = tasks(&names).into_iter().map(|t| (t.name, t.harnesses.len())).collect();
-        let want = [
-            ("harnesses::nibble_round_trip", 1),
-            ("co401gw1/dictionary_proofs::write_keeps_the_rules_mixed_*", 2),
-            ("co401gw1/dictionary_proofs::write_keeps_the_rules_digital_*", 1),
-            ("co401gw1/dictionary_proofs::read_keeps_the_rules_mixed", 1),
-            ("co401gw1/dictionary_proofs::write_keeps_the_rules_digitalalt_*", 1),
-        ];
-        assert_eq!(got, want.map(|(n, c)| (n.to_string(), c)));
+        assert_eq!(counts, [15 + 2, 17 + 6, 4, 10 + 2]);
+        assert_eq!(harness_count(), handwritten_count() + 56);
     }
 }

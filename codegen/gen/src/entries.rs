@@ -114,18 +114,6 @@ fn runs(d: &Device, mode: Option<&str>) -> Vec<Run> {
     out
 }
 
-/// The objects a mode's table lists, in index order: each object's index and how many
-/// consecutive objects after it its runs also describe (its copies).
-pub(crate) fn listed_objects(d: &Device, mode: Option<&str>) -> Vec<(u16, u8)> {
-    let mut out: Vec<(u16, u8)> = Vec::new();
-    for r in runs(d, mode) {
-        if out.last().is_none_or(|&(index, _)| index != r.index) {
-            out.push((r.index, r.copies));
-        }
-    }
-    out
-}
-
 fn ident(name: &str) -> Ident {
     Ident::new(name, Span::call_site())
 }

@@ -33,8 +33,6 @@ mod pdos;
 mod serial;
 pub mod serial_proofs;
 
-pub use dictionary_proofs::harness_count as dictionary_harness_count;
-
 use coforge_spec::Device;
 use proc_macro2::{Literal, Span, TokenStream};
 use quote::quote;
