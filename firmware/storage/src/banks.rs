@@ -293,10 +293,14 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
                     s.set(flags);
                 }
                 let seq = w.record.seq();
+                // The repair writes from a copy of the winner's data, not through `w`: Kani
+                // (CBMC 6.6) read `w.data` through the reference chosen by `winner` as the
+                // loser's bytes, a false counterexample (verification/README.md).
+                let data = w.data;
                 // A failed repair leaves the loser invalid; the winner is still intact.
-                let mirrored = repair && self.write_copy(loser, block, l, &w.data, seq).is_ok();
+                let mirrored = repair && self.write_copy(loser, block, l, &data, seq).is_ok();
                 self.set_lost(block, false);
-                Ok(Settled { data: w.data, seq, mirrored })
+                Ok(Settled { data, seq, mirrored })
             }
             Verdict::Lost => {
                 // Indexed, not `zip`: Kani cannot bound a `zip` loop by its length.
