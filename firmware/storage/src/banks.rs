@@ -288,19 +288,22 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
                 Ok(Settled { data: a.data, seq: a.record.seq(), mirrored: true })
             }
             Verdict::Use { winner, repair, flags } => {
-                let (w, loser, l) = if winner == 0 { (a, 1, b) } else { (b, 0, a) };
+                let loser = winner ^ 1;
+                // Indexed, not picked with `if winner == 0 { (a, b) } else { (b, a) }`: Kani
+                // (CBMC 6.6) read the winner's data through such a reference as the loser's,
+                // a false counterexample (verification/README.md). `resolve` names bank 0 or
+                // 1, so the `else` is never taken.
+                let (Some(w), Some(l)) = (copies.get(winner), copies.get(loser)) else {
+                    return Err(Error::OutOfRange);
+                };
                 if let Some(s) = self.status.get_mut(loser) {
                     s.set(flags);
                 }
                 let seq = w.record.seq();
-                // The repair writes from a copy of the winner's data, not through `w`: Kani
-                // (CBMC 6.6) read `w.data` through the reference chosen by `winner` as the
-                // loser's bytes, a false counterexample (verification/README.md).
-                let data = w.data;
                 // A failed repair leaves the loser invalid; the winner is still intact.
-                let mirrored = repair && self.write_copy(loser, block, l, &data, seq).is_ok();
+                let mirrored = repair && self.write_copy(loser, block, l, &w.data, seq).is_ok();
                 self.set_lost(block, false);
-                Ok(Settled { data, seq, mirrored })
+                Ok(Settled { data: w.data, seq, mirrored })
             }
             Verdict::Lost => {
                 // Indexed, not `zip`: Kani cannot bound a `zip` loop by its length.
