@@ -299,7 +299,7 @@ pub fn slot<const BLOCK: usize>(image: &[u8], block: usize) -> &[u8] {
 /// Block `block`'s copy in a bank image is committed: its record matches its data.
 pub fn copy_is_valid<const BLOCK: usize>(image: &[u8], block: usize) -> bool {
     match slot::<BLOCK>(image, block).split_at_checked(BLOCK) {
-        Some((data, &[begin, lo, hi, end])) => Record::from_bytes([begin, lo, hi, end]).is_valid_for(data),
+        Some((data, &[begin, lo, hi, end])) => <&[u8; BLOCK]>::try_from(data).is_ok_and(|data| Record::from_bytes([begin, lo, hi, end]).is_valid_for(data)),
         _ => false,
     }
 }

@@ -79,11 +79,14 @@ impl Crc16 {
 
     #[inline]
     pub fn update(&self, crc: u16, data: &[u8]) -> u16 {
-        // A loop, not `fold`: Kani (CBMC 6.6) never reduces a slice `fold` over known bytes
-        // to a constant, so every proof that checks a CRC would explore both outcomes.
+        // Indexed, not `fold` or `for &b in data`: Kani (CBMC 6.6) never reduces a `fold`
+        // over known bytes to a constant, and cannot bound a slice iterator's loop when the
+        // slice may point into more than one array (it unrolls it to the harness's bound).
         let mut crc = crc;
-        for &b in data {
+        let mut i = 0;
+        while let Some(&b) = data.get(i) {
             crc = self.step(crc, b);
+            i += 1;
         }
         crc
     }

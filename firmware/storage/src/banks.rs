@@ -1,5 +1,7 @@
 //! The two mirrored banks over any two `embedded-storage` devices.
 
+use core::ops::Range;
+
 use crate::record::{RECORD, Record, block_crc, offset};
 use crate::resolve::{CopyState, Verdict, resolve};
 use crate::status::BankStatus;
@@ -172,11 +174,10 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
     /// Reads `out.len()` data bytes from `addr`, comparing both banks; a block whose copies
     /// differ is resolved and repaired before its bytes are returned.
     pub fn read(&mut self, addr: usize, out: &mut [u8]) -> Result<(), Error> {
-        let mut done = 0;
-        for (block, at, n) in Self::chunks(addr, out.len())? {
-            let dst = out.get_mut(done..done + n).ok_or(Error::OutOfRange)?;
-            self.read_in_block(block, at, dst)?;
-            done += n;
+        let end = Self::end(addr, out.len())?;
+        for k in 0..BLOCKS {
+            let Some((block, at, range)) = Self::piece(addr, end, k) else { break };
+            self.read_in_block(block, at, out.get_mut(range).ok_or(Error::OutOfRange)?)?;
         }
         Ok(())
     }
@@ -185,11 +186,10 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
     /// a write spanning blocks may be cut between them. Writing what is already stored
     /// costs no EEPROM write.
     pub fn write(&mut self, addr: usize, data: &[u8]) -> Result<(), Error> {
-        let mut done = 0;
-        for (block, at, n) in Self::chunks(addr, data.len())? {
-            let src = data.get(done..done + n).ok_or(Error::OutOfRange)?;
-            self.write_in_block(block, at, src)?;
-            done += n;
+        let end = Self::end(addr, data.len())?;
+        for k in 0..BLOCKS {
+            let Some((block, at, range)) = Self::piece(addr, end, k) else { break };
+            self.write_in_block(block, at, data.get(range).ok_or(Error::OutOfRange)?)?;
         }
         Ok(())
     }
@@ -211,33 +211,33 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
         self.check_block(block)
     }
 
-    /// Splits `len` bytes from `addr` into `(block, offset in block, length)` pieces.
-    fn chunks(addr: usize, len: usize) -> Result<impl Iterator<Item = (usize, usize, usize)>, Error> {
-        let end = addr.checked_add(len).filter(|&e| e <= Self::DATA_SIZE).ok_or(Error::OutOfRange)?;
-        let mut pos = addr;
-        let pieces = core::iter::from_fn(move || {
-            if pos >= end || BLOCK == 0 {
-                return None;
-            }
-            let (block, at) = (pos / BLOCK, pos % BLOCK);
-            let n = (BLOCK - at).min(end - pos);
-            pos += n;
-            Some((block, at, n))
-        });
-        // A range inside the data area touches each block at most once, so there are at most
-        // BLOCKS pieces and `take` changes nothing; it gives the loops over the pieces a
-        // constant bound, which Kani (CBMC) needs to stop unrolling them at BLOCKS.
-        Ok(pieces.take(BLOCKS))
+    /// The end of `len` bytes from `addr`, if they lie in the data area.
+    fn end(addr: usize, len: usize) -> Result<usize, Error> {
+        addr.checked_add(len).filter(|&e| e <= Self::DATA_SIZE).ok_or(Error::OutOfRange)
+    }
+
+    /// Piece `k` of the data range `addr..end` (at most one per block, in block order): its
+    /// block, its offset in the block and its place in the range; `None` past the last one.
+    /// Callers loop `k` over `0..BLOCKS`, a constant bound: Kani (CBMC) unrolled a loop over an
+    /// iterator of the pieces to the harness's bound when `addr` was symbolic.
+    fn piece(addr: usize, end: usize, k: usize) -> Option<(usize, usize, Range<usize>)> {
+        let block = addr.checked_div(BLOCK)?.checked_add(k)?;
+        let start = block.checked_mul(BLOCK)?;
+        let (from, to) = (start.max(addr), start.checked_add(BLOCK)?.min(end));
+        (from < to).then(|| (block, from - start, from - addr..to - addr))
     }
 
     fn read_in_block(&mut self, block: usize, at: usize, dst: &mut [u8]) -> Result<(), Error> {
         if !self.is_lost(block) {
-            let mut other = [0_u8; BLOCK];
-            let other = other.get_mut(..dst.len()).ok_or(Error::OutOfRange)?;
+            // Both reads land in whole-block buffers that start equal, so the comparison has a
+            // constant length: Kani (CBMC) unrolls a compare of `dst.len()` bytes to its bound.
+            let n = dst.len();
+            let (mut mine, mut other) = ([0_u8; BLOCK], [0_u8; BLOCK]);
             let base = Self::slot(block) + at;
-            let a = self.get(0, base, dst);
-            let b = self.get(1, base, other);
-            if a.is_ok() && b.is_ok() && dst == other {
+            let a = self.get(0, base, mine.get_mut(..n).ok_or(Error::OutOfRange)?);
+            let b = self.get(1, base, other.get_mut(..n).ok_or(Error::OutOfRange)?);
+            if a.is_ok() && b.is_ok() && mine == other {
+                dst.copy_from_slice(mine.get(..n).ok_or(Error::OutOfRange)?);
                 return Ok(());
             }
         }
@@ -407,9 +407,10 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
     fn set_block_sum(&mut self, bank: usize, block: usize, data: &[u8; BLOCK]) {
         if let Some(sum) = self.block_sums.get_mut(bank).and_then(|sums| sums.get_mut(block)) {
             // At most 255 * BLOCK; blocks beyond 257 bytes would need a wider sum.
+            // Indexed, not `for &b in data`: see `Crc16::update`.
             *sum = 0;
-            for &b in data {
-                *sum = sum.wrapping_add(u16::from(b));
+            for i in 0..BLOCK {
+                *sum = sum.wrapping_add(data.get(i).copied().map_or(0, u16::from));
             }
         }
     }

@@ -25,10 +25,14 @@ pub fn find_run(entries: &[EntryInfo], index: u16, sub: u8) -> Result<usize, Sdo
     let listed = entries.partition_point(|e| e.index <= index);
     let last = listed.checked_sub(1).ok_or(SdoAbort::NoObject)?;
     let first = match entries.get(last) {
-        // The object's last run: most accesses end here (single-run objects, and the subs
-        // of the last run), without the second search.
-        Some(e) if e.covers_index(index) && e.sub <= sub => return if e.covers(sub) { Ok(last) } else { Err(SdoAbort::NoSubIndex) },
-        Some(e) if e.covers_index(index) => e.index,
+        Some(e) if e.covers_index(index) => {
+            // The object's last run: most accesses end here (single-run objects, and the
+            // subs of the last run), without the second search.
+            if e.sub <= sub {
+                return if e.covers(sub) { Ok(last) } else { Err(SdoAbort::NoSubIndex) };
+            }
+            e.index
+        }
         _ => return Err(SdoAbort::NoObject),
     };
     // The sub-index: only the object's last run starting at or before `sub` can cover it. A
