@@ -63,8 +63,10 @@ const STM32F0_CANOPENIA: Board = Board { devices: &["canopenia"], features: &["c
 const STM32F091: Board = Board { name: "stm32f091", devices: &["canopenia"], flash: (0x0800_0000, 240 * 1024), ram: (0x2000_0000, 32 * 1024), ..STM32F0 };
 
 /// The STM32F072CB board (`firmware/boards/stm32f072`, the board code of `stm32f0` built for
-/// this chip with its CR3101 board: SD card on SPI1, RTC): 128 KiB of flash, 16 KiB of RAM.
-const STM32F072: Board = Board { name: "stm32f072", devices: &["cr3101"], flash: (0x0800_0000, 128 * 1024), ram: (0x2000_0000, 16 * 1024), ..STM32F0 };
+/// this chip): 128 KiB of flash, 16 KiB of RAM. The CR3101 with its SD card on SPI1 and the
+/// RTC, and the CO401GW1 on the gateway's STM32F042C6 board, with which the F072CB in LQFP48
+/// is pin-compatible (the F042C6 image is in [`PENDING`]).
+const STM32F072: Board = Board { name: "stm32f072", devices: &["cr3101", "co401gw1"], flash: (0x0800_0000, 128 * 1024), ram: (0x2000_0000, 16 * 1024), ..STM32F0 };
 
 /// The ELF an image build leaves in the board crate's target directory.
 pub(crate) fn built_elf(board: &Board, device: &str) -> PathBuf {

@@ -17,7 +17,7 @@
 
 use crate::i2c::{self, PARAM_EEPROM_BYTES, ParamEeprom};
 use crate::serve::serve;
-use crate::{can, clock};
+use crate::{can, clock, halt};
 use canopenia::app::Typed;
 #[cfg(not(feature = "stm32f091"))]
 use canopenia::config::slots::NoMemory;
@@ -56,6 +56,10 @@ const _: () = assert!(BlockStore::<ParamEeprom>::capacity_for(<Od<Typed<App>> as
 /// Sets up the chip, builds the coprocessor and serves it for ever. Called once, from the
 /// image's entry point (a second call finds the peripherals and the coprocessor taken and
 /// halts).
+///
+/// `#[inline]`: compiled with the image rather than optimised in this library first, which
+/// left it 396 bytes larger.
+#[inline]
 pub fn run() -> ! {
     let (Some(core), Some(mut p)) = (cortex_m::Peripherals::take(), pac::Peripherals::take()) else { halt() };
     let mut rcc = clock::start_core(p.RCC, &mut p.FLASH, core.SYST);
@@ -101,13 +105,6 @@ pub fn run() -> ! {
 #[inline(never)]
 fn mount(store: BlockStore<ParamEeprom>, files: Files) -> Option<&'static mut Coprocessor> {
     cortex_m::singleton!(: Coprocessor = Canopenia::with_configuration(NODE_ID, store, files))
-}
-
-/// Stops for good (started twice).
-fn halt() -> ! {
-    loop {
-        cortex_m::asm::wfi();
-    }
 }
 
 /// The chip's serial number for 1018h.4: its 96-bit unique ID folded to 32 bits (XOR of its

@@ -8,6 +8,10 @@
 //! typed pins: 21 typed pins cost about 1 KiB of flash for their mode changes and accesses.
 //! The HAL keeps the pins of its peripherals (USART2, bxCAN, I2C1) and the chain's three.
 
+mod run;
+
+pub use run::{Chip, run};
+
 use crate::board::ConfigWord;
 use co401gw1::Board;
 use stm32f0xx_hal::pac::{self, gpioa, gpiof};

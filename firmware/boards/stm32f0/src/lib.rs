@@ -72,6 +72,12 @@
 //! `firmware/boards/stm32f072`, which builds this library with the features `stm32f072` and
 //! `cr3101`: the SD card on SPI1, the RTC, five status LEDs, the parameters in a 24C128 (pins
 //! in `firmware/boards/stm32f072/PINS.md`).
+//!
+//! # CO401GW1 on the STM32F042C6 and the STM32F072CB
+//!
+//! [`gw1::run`] is the whole CO401GW1 image on the gateway's board (`PINS-co401gw1.md`): this
+//! crate's `co401gw1` for the STM32F042C6 (feature `co401gw1-image`, pending in `dist`: over
+//! the chip's flash), and `firmware/boards/stm32f072`'s for the pin-compatible STM32F072CB.
 #![no_std]
 // One read of a status register (`serve::esr`), the GW1 board's port registers (`gw1::Ports`),
 // the F091's configuration flash (`config_flash`: programming and reading it in place) and the
@@ -92,3 +98,11 @@ pub mod cr3101;
 pub mod gw1;
 pub mod i2c;
 pub mod serve;
+
+/// Stops for good: the peripherals were taken twice, or the board's pins name no valid
+/// setting (the images' start-up).
+pub(crate) fn halt() -> ! {
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
