@@ -816,17 +816,23 @@ pub struct DoubleOutcome {
     pub others_kept: bool,
     /// A one-byte write restarts the block from zeros and sets 0x40 in both banks.
     pub restarted: bool,
+    /// Found by a read: the read answered `Lost`, or both banks hold the very bytes it
+    /// returned. A read compares the banks' data (the datasheet's "different data within the
+    /// two memory banks") and checks a block's CRCs only when they differ, so a corruption
+    /// that leaves the data of both copies equal (in their records, or the same value at the
+    /// same byte) is first seen by `check_block`, the scrub or a reboot.
+    pub read_agreed: bool,
 }
 
 impl DoubleOutcome {
     pub fn is_clean(&self) -> bool {
-        !self.applied || (self.reported_lost && !self.data_returned && self.others_kept && self.restarted)
+        !self.applied || (self.read_agreed && self.reported_lost && !self.data_returned && self.others_kept && self.restarted)
     }
 }
 
 /// Corrupts byte `offsets[i]` of block `block`'s slot in bank `i` with `values[i]` in settled
-/// banks, looks for it via a reboot or `check_block` (`Detect::Read` is taken as
-/// `check_block`), then reads every byte of the block and restarts it with a write.
+/// banks, looks for it via a reboot, `check_block`, or a read of the block followed by
+/// `check_block`, then reads every byte of the block and restarts it with a write.
 pub fn check_double_corruption<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
     mut banks: Banks<'p, N, BLOCKS, BLOCK>,
     block: usize,
@@ -849,10 +855,20 @@ pub fn check_double_corruption<'p, const N: usize, const BLOCKS: usize, const BL
         applied &= before[bank][pos] != value;
         banks.banks_mut()[bank].as_bytes_mut()[pos] = value;
     }
-    let via = if via == Detect::Mount { Detect::Mount } else { Detect::CheckBlock };
-    let (mut banks, _) = detect(banks, block, via);
-    let mut out = DoubleOutcome { applied, ..DoubleOutcome::default() };
+    let corrupted = images(&banks);
+    let (mut banks, found) = detect(banks, block, via);
     let lost = Err(Error::Lost { block });
+    let held = |bank: usize, data: &[u8; BLOCK]| slot::<BLOCK>(&corrupted[bank], block).get(..BLOCK) == Some(data);
+    let read_agreed = match found {
+        None => true,
+        Some(Ok(data)) => held(0, &data) && held(1, &data),
+        Some(Err(e)) => Err(e) == lost,
+    };
+    if via == Detect::Read {
+        // The rest is what `check_block` (or the scrub) finds.
+        let _ = banks.check_block(block);
+    }
+    let mut out = DoubleOutcome { applied, read_agreed, ..DoubleOutcome::default() };
     let mut every_read_lost = banks.read(block * BLOCK, &mut [0; BLOCK]) == lost;
     for at in 0..BLOCK {
         let r = banks.read(block * BLOCK + at, &mut [0]);
