@@ -66,7 +66,8 @@ const STM32F091: Board = Board { name: "stm32f091", devices: &["canopenia"], fla
 /// this chip): 128 KiB of flash, 16 KiB of RAM. The CR3101 with its SD card on SPI1 and the
 /// RTC, and the CO401GW1 on the gateway's STM32F042C6 board, with which the F072CB in LQFP48
 /// is pin-compatible (the F042C6 image is in [`PENDING`]).
-const STM32F072: Board = Board { name: "stm32f072", devices: &["cr3101", "co401gw1"], flash: (0x0800_0000, 128 * 1024), ram: (0x2000_0000, 16 * 1024), ..STM32F0 };
+const STM32F072: Board =
+    Board { name: "stm32f072", devices: &["cr3101", "co401gw1"], flash: (0x0800_0000, 128 * 1024), ram: (0x2000_0000, 16 * 1024), ..STM32F0 };
 
 /// The ELF an image build leaves in the board crate's target directory.
 pub(crate) fn built_elf(board: &Board, device: &str) -> PathBuf {

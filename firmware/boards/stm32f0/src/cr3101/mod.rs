@@ -20,9 +20,9 @@
 pub mod rtc;
 pub mod sd;
 
-use crate::{clock, halt};
 use crate::i2c::{self, PARAM_EEPROM_BYTES, ParamEeprom};
 use crate::serve::{NoHost, OwnIndicators, serve_started};
+use crate::{clock, halt};
 use coforge_stack::device::Device as _;
 use coforge_stack::od::NodeDictionary;
 use coforge_stack::store::BlockStore;
