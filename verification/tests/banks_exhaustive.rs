@@ -450,3 +450,26 @@ fn the_kani_check_block_counterexample_is_found_and_repaired() {
         }
     }
 }
+
+/// Kani's counterexample to `banks_double_corruption_of_block_0_found_by_a_reboot_is_lost`
+/// (stop 29), on the harnesses' 2 x 2 geometry: block 0 holds zeros committed as sequence
+/// 89h, block 1 is formatted (zeros, sequence 0). CRC(00 00 89h) = CC3Dh and CRC(00 00 00) =
+/// CC9Ch differ in their low byte only, so setting that byte to 9Ch in both banks makes both
+/// copies of block 0 hold zeros and the CRC of sequence 0: what a format cut short leaves.
+/// Both copies still have `begin == end`, which a format cut never leaves in both, so a
+/// reboot must report the block lost, not finish a format nobody started.
+#[test]
+fn a_double_corruption_that_mimics_a_format_cut_is_still_lost() {
+    const BLOCK: usize = 2;
+    const N: usize = 2 * (BLOCK + 4);
+    let power = Power::new();
+    let data = [[0; BLOCK]; 2];
+    let banks = Banks::<N, 2, BLOCK>::mount(committed_devices::<N, 2, BLOCK>(&power, &data, &[0x89, 0]));
+    assert_eq!(images(&banks)[0][BLOCK + 1], 0x3D, "CRC low byte of zeros committed as 89h");
+    for via in [Detect::Mount, Detect::Read, Detect::CheckBlock] {
+        let banks = Banks::<N, 2, BLOCK>::mount(committed_devices::<N, 2, BLOCK>(&power, &data, &[0x89, 0]));
+        let (_, out) = check_double_corruption(banks, 0, [BLOCK + 1; 2], [0x9C; 2], via);
+        assert!(out.applied);
+        assert!(out.is_clean(), "via {via:?}: {out:?}");
+    }
+}

@@ -38,6 +38,16 @@ impl<const BLOCK: usize> Copy<BLOCK> {
     fn is_format_staged(&self) -> bool {
         self.data.iter().all(|&b| b == 0) && self.record.crc == block_crc(&self.data, 0) && (self.record.begin, self.record.end) != (0, 0)
     }
+
+    /// Both copies of a lost block are as a format cut short leaves them. Staging opens every
+    /// copy (`begin != end`) and the commit phase finishes bank 1 before it touches bank 2, so
+    /// a cut leaves at least one copy open. A corrupted byte in each copy of a committed block
+    /// leaves both markers equal: zeros committed as sequence 89h, say, whose CRC differs from
+    /// that of sequence 0 in one byte, become two staged-looking copies, and that block is
+    /// lost, not a format to finish.
+    fn left_by_a_format_cut(copies: &[Self; 2]) -> bool {
+        copies.iter().all(Self::is_format_staged) && copies.iter().any(|c| c.record.begin != c.record.end)
+    }
 }
 
 /// A block's contents once both banks agree on them.
@@ -89,7 +99,7 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
             // must not change the decision at the next mount.
             format_cut &= match me.settle(block, &copies) {
                 Ok(settled) => settled.seq == 0 && settled.data.iter().all(|&b| b == 0),
-                Err(_) => copies.iter().all(Copy::is_format_staged),
+                Err(_) => Copy::left_by_a_format_cut(&copies),
             };
         }
         if (blank || format_cut) && me.lost.iter().any(|&l| l) {
