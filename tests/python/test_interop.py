@@ -355,9 +355,11 @@ def test_nmt_states_through_heartbeat(start, name):
         dev.nmt(command)
         hb = dev.wait_heartbeat(state, mark=mark)
         assert hb is not None, f"no heartbeat with state {state:#04x} after NMT command {command:#04x}"
-        # Every heartbeat after that one keeps the new state.
+        # Every heartbeat after that one keeps the new state. wait_count returns at least two:
+        # a loaded host can deliver two 20 ms beats in one batch, so a third may come with them.
         later = dev.rec.wait_count(dev.nmt_err_cob, dev.rec.mark(), 2, 1.0)
-        assert [f.data for f in later] == [bytes([state])] * len(later) and len(later) == 2
+        assert len(later) >= 2, f"only {len(later)} heartbeats within 1 s at a 20 ms period"
+        assert [f.data for f in later] == [bytes([state])] * len(later), f"heartbeats {later}"
         assert dev.node.nmt.state == text
         if state == STOPPED:
             # CiA 301: no SDO in Stopped; the request goes unanswered.
