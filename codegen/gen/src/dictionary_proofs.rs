@@ -13,6 +13,10 @@ use quote::{format_ident, quote};
 /// more to reach "too long", and strings cut short.
 pub const DATA: usize = 5;
 
+/// String bytes of the write harnesses' `TypedCells`: at least [`DATA`], and what the test
+/// that the generated fields answer as the cells do compares.
+const CELL_STRING: usize = 16;
+
 /// The value buffer of `coforge_stack::od::properties` (`BUF`): the longest loop of a constant
 /// length the harnesses reach.
 const READ_BUF: usize = 16;
@@ -37,17 +41,21 @@ pub fn proofs_module(device: &Device, modes: &Modes, options: &Options) -> Token
         let write = format_ident!("write_keeps_the_rules_{}", name);
         let read = format_ident!("read_keeps_the_rules_{}", name);
         let n = dec(DATA as u64);
+        let cells = dec(CELL_STRING as u64);
         quote! {
-            /// Any write keeps the dictionary's rules (`prop_write_is_checked`).
+            /// Any write keeps the dictionary's rules (`prop_write_is_checked`), on this
+            /// mode's table with `TypedCells` in place of the generated fields; that the
+            /// fields answer as the cells do is `tests/dictionary_properties.rs`.
             #[kani::proof]
             #[kani::unwind(#unwind)]
             #[kani::solver(kissat)]
             fn #write() {
-                let mut od = super::Od::new(super::Mode::#variant, kani::any_where(|id: &u8| (1..=127).contains(id)), #stack::od::NoAppObjects);
+                let od = super::Od::new(super::Mode::#variant, 1, #stack::od::NoAppObjects);
+                let mut cells = #stack::od::properties::TypedCells::<#cells>::over(&od).holding(kani::any(), kani::any_where(|n: &usize| *n <= 8));
                 let data: [u8; #n] = kani::any();
                 let len: usize = kani::any_where(|l: &usize| *l <= #n);
                 let ctx = #stack::od::AccessContext { nmt: any_state(), can_enabled: kani::any() };
-                #stack::od::properties::prop_write_is_checked(&mut od, kani::any(), kani::any(), &data[..len], any_side(), &ctx);
+                #stack::od::properties::prop_write_is_checked(&mut cells, kani::any(), kani::any(), &data[..len], any_side(), &ctx);
             }
 
             /// Any read keeps the dictionary's rules (`prop_read_is_checked`).

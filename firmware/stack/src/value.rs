@@ -111,6 +111,17 @@ impl<const N: usize> Bytes<N> {
         Bytes { bytes, len: i }
     }
 
+    /// The first `N` bytes of `data` (all of them when it is shorter).
+    pub fn from_slice(data: &[u8]) -> Self {
+        let mut value = Self::default();
+        let len = data.len().min(N);
+        if let (Some(dst), Some(src)) = (value.bytes.get_mut(..len), data.get(..len)) {
+            dst.copy_from_slice(src);
+            value.len = len;
+        }
+        value
+    }
+
     pub fn as_bytes(&self) -> &[u8] {
         self.bytes.get(..self.len).unwrap_or(&[])
     }
@@ -197,6 +208,8 @@ mod tests {
         assert_eq!(s.read(&e, 0, &mut buf), Ok(ReadLen { copied: 3, total: 3 }));
         assert_eq!(s.write(&e, b"123456789"), Err(SdoAbort::LengthTooHigh));
         assert_eq!(s.as_bytes(), b"oil", "a refused write keeps the stored value");
+        assert_eq!(Bytes::<4>::from_slice(b"abcdef").as_bytes(), b"abcd", "cut at the capacity");
+        assert_eq!(Bytes::<8>::from_slice(b"ab").as_bytes(), b"ab");
     }
 
     #[test]

@@ -8,7 +8,8 @@
 //! refused write changes nothing.
 #![allow(clippy::panic)]
 
-use super::{Access, AccessContext, EntryAccess, EntryInfo, HostAccess, SdoAbort, Side, Storage};
+use super::{Access, AccessContext, DataType, EntryAccess, EntryInfo, HostAccess, Limits, NoAppObjects, SdoAbort, Side, Storage};
+use crate::value::{Bytes, OdValue};
 
 /// The longest value the properties read back.
 const BUF: usize = 16;
@@ -98,5 +99,117 @@ pub fn prop_read_is_checked<D: EntryAccess>(od: &mut D, index: u16, sub: u8, sid
         (Some(abort), result) => assert!(result == Err(abort), "the rule's abort"),
         (None, Ok(n)) => assert!(n.total <= usize::from(info.size), "a value fits its entry"),
         (None, Err(_)) => {}
+    }
+}
+
+/// A dictionary with a generated table and, in place of the generated fields, one cell per
+/// Rust type a field of that data type has (`rust_type` in the generator: 24-bit integers in
+/// `u32`/`i32`, strings and domains in `Bytes`, of `S` bytes here). The Kani write harnesses
+/// prove [`prop_write_is_checked`] on it: symbolic execution of a write into the whole
+/// generated struct through `&mut dyn OdValue` did not end (see verification/README.md), while
+/// the lookup, the access, length and value checks and every `OdValue` write are the real
+/// code here. That the generated fields behave as these cells do, entry by entry, is a test
+/// (`tests/dictionary_properties.rs` in the verification crate).
+///
+/// Entries of one type share a cell: the properties only read back the entry just written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TypedCells<const S: usize> {
+    entries: &'static [EntryInfo],
+    limits: &'static [Limits],
+    app: NoAppObjects,
+    boolean: bool,
+    u8: u8,
+    u16: u16,
+    u32: u32,
+    u64: u64,
+    i8: i8,
+    i16: i16,
+    i32: i32,
+    i64: i64,
+    f32: f32,
+    f64: f64,
+    bytes: Bytes<S>,
+}
+
+impl<const S: usize> TypedCells<S> {
+    /// The table (and limits) of `od`, every cell zero or empty.
+    pub fn over<D: EntryAccess>(od: &D) -> Self {
+        TypedCells {
+            entries: od.entries(),
+            limits: od.limits(),
+            app: NoAppObjects,
+            boolean: false,
+            u8: 0,
+            u16: 0,
+            u32: 0,
+            u64: 0,
+            i8: 0,
+            i16: 0,
+            i32: 0,
+            i64: 0,
+            f32: 0.0,
+            f64: 0.0,
+            bytes: Bytes::default(),
+        }
+    }
+}
+
+impl<const S: usize> TypedCells<S> {
+    /// Every cell holding a value taken from `raw`: each integer and float its first bytes,
+    /// the boolean bit 0, the string the first `text_len` (at most 8). Harnesses pass symbolic
+    /// bytes, so that "a refused write changes nothing" is checked against any stored value,
+    /// not only against zero.
+    pub fn holding(mut self, raw: [u8; 8], text_len: usize) -> Self {
+        let [b0, b1, b2, b3, ..] = raw;
+        self.boolean = b0 & 1 != 0;
+        self.u8 = b0;
+        self.i8 = b0 as i8;
+        self.u16 = u16::from_le_bytes([b0, b1]);
+        self.i16 = i16::from_le_bytes([b0, b1]);
+        self.u32 = u32::from_le_bytes([b0, b1, b2, b3]);
+        self.i32 = i32::from_le_bytes([b0, b1, b2, b3]);
+        self.f32 = f32::from_le_bytes([b0, b1, b2, b3]);
+        self.u64 = u64::from_le_bytes(raw);
+        self.i64 = i64::from_le_bytes(raw);
+        self.f64 = f64::from_le_bytes(raw);
+        self.bytes = Bytes::from_slice(raw.get(..text_len).unwrap_or(&raw));
+        self
+    }
+}
+
+impl<const S: usize> EntryAccess for TypedCells<S> {
+    type App = NoAppObjects;
+
+    fn entries(&self) -> &'static [EntryInfo] {
+        self.entries
+    }
+
+    fn limits(&self) -> &'static [Limits] {
+        self.limits
+    }
+
+    fn field(&mut self, info: &EntryInfo, _: u8) -> Option<&mut dyn OdValue> {
+        use DataType::*;
+        if info.storage() == Storage::App {
+            return None;
+        }
+        Some(match info.data_type() {
+            Boolean => &mut self.boolean,
+            Unsigned8 => &mut self.u8,
+            Unsigned16 => &mut self.u16,
+            Unsigned24 | Unsigned32 => &mut self.u32,
+            Unsigned40 | Unsigned48 | Unsigned56 | Unsigned64 => &mut self.u64,
+            Integer8 => &mut self.i8,
+            Integer16 => &mut self.i16,
+            Integer24 | Integer32 => &mut self.i32,
+            Integer40 | Integer48 | Integer56 | Integer64 => &mut self.i64,
+            Real32 => &mut self.f32,
+            Real64 => &mut self.f64,
+            VisibleString | OctetString | UnicodeString | Domain | TimeOfDay | TimeDifference => &mut self.bytes,
+        })
+    }
+
+    fn app(&mut self) -> &mut NoAppObjects {
+        &mut self.app
     }
 }
