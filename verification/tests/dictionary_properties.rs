@@ -11,13 +11,16 @@ use coforge_stack::od::{AccessContext, EntryAccess, NmtState, NoAppObjects, Node
 
 const CASES: usize = 60_000;
 
+/// String bytes of `TypedCells`, as the generated Kani write harnesses have them.
+const CELL_STRING: usize = 16;
+
 fn check<D: NodeDictionary>(make: impl Fn(D::Mode) -> D, seed: u64) -> usize {
     let mut rng = fastrand::Rng::with_seed(seed);
     let mut n = 0;
     for &mode in D::MODES {
         let mut od = make(mode);
         // The Kani write harnesses' dictionary, on the same accesses.
-        let mut cells = TypedCells::<16>::over(&od).holding(rng.u64(..).to_le_bytes(), rng.usize(..=8));
+        let mut cells = TypedCells::<CELL_STRING>::over(&od, rng.u64(..).to_le_bytes(), rng.usize(..=8));
         let table = od.entries();
         for _ in 0..CASES / D::MODES.len() {
             let run = &table[rng.u64(..table.len() as u64) as usize];
@@ -88,13 +91,13 @@ fn test_value(pattern: usize, len: usize, rng: &mut fastrand::Rng) -> Vec<u8> {
 /// reads back the same bytes. A field of another type than the cell's, a missing field or a
 /// field with its own checks would answer differently.
 fn cells_behave_as_fields<D: NodeDictionary>(make: impl Fn(D::Mode) -> D) -> usize {
-    const S: usize = 16;
+    const S: usize = CELL_STRING;
     let ctx = AccessContext { nmt: NmtState::PreOperational, can_enabled: false };
     let mut rng = fastrand::Rng::with_seed(17);
     let mut compared = 0;
     for &mode in D::MODES {
         let mut od = make(mode);
-        let mut cells = TypedCells::<S>::over(&od).holding(*b"\x81\x42coforg", 5);
+        let mut cells = TypedCells::<S>::over(&od, *b"\x81\x42coforg", 5);
         for run in od.entries() {
             for index in (0..=u16::from(run.copies())).map(|k| run.index + k) {
                 for sub in run.sub..=run.last_sub {

@@ -51,7 +51,7 @@ pub fn proofs_module(device: &Device, modes: &Modes, options: &Options) -> Token
             #[kani::solver(kissat)]
             fn #write() {
                 let od = super::Od::new(super::Mode::#variant, 1, #stack::od::NoAppObjects);
-                let mut cells = #stack::od::properties::TypedCells::<#cells>::over(&od).holding(kani::any(), kani::any_where(|n: &usize| *n <= 8));
+                let mut cells = #stack::od::properties::TypedCells::<#cells>::over(&od, kani::any(), kani::any_where(|n: &usize| *n <= 8));
                 let data: [u8; #n] = kani::any();
                 let len: usize = kani::any_where(|l: &usize| *l <= #n);
                 let ctx = #stack::od::AccessContext { nmt: any_state(), can_enabled: kani::any() };

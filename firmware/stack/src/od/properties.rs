@@ -132,48 +132,29 @@ pub struct TypedCells<const S: usize> {
 }
 
 impl<const S: usize> TypedCells<S> {
-    /// The table (and limits) of `od`, every cell zero or empty.
-    pub fn over<D: EntryAccess>(od: &D) -> Self {
+    /// The table (and limits) of `od`, every cell holding a value taken from `raw`: each
+    /// integer and float its first bytes, the boolean bit 0, the string the first `text_len`
+    /// (at most 8). Harnesses pass symbolic bytes, so that "a refused write changes nothing"
+    /// is checked against any stored value, not only against zero.
+    pub fn over<D: EntryAccess>(od: &D, raw: [u8; 8], text_len: usize) -> Self {
+        let [b0, b1, b2, b3, ..] = raw;
         TypedCells {
             entries: od.entries(),
             limits: od.limits(),
             app: NoAppObjects,
-            boolean: false,
-            u8: 0,
-            u16: 0,
-            u32: 0,
-            u64: 0,
-            i8: 0,
-            i16: 0,
-            i32: 0,
-            i64: 0,
-            f32: 0.0,
-            f64: 0.0,
-            bytes: Bytes::default(),
+            boolean: b0 & 1 != 0,
+            u8: b0,
+            u16: u16::from_le_bytes([b0, b1]),
+            u32: u32::from_le_bytes([b0, b1, b2, b3]),
+            u64: u64::from_le_bytes(raw),
+            i8: b0 as i8,
+            i16: i16::from_le_bytes([b0, b1]),
+            i32: i32::from_le_bytes([b0, b1, b2, b3]),
+            i64: i64::from_le_bytes(raw),
+            f32: f32::from_le_bytes([b0, b1, b2, b3]),
+            f64: f64::from_le_bytes(raw),
+            bytes: Bytes::from_slice(raw.get(..text_len).unwrap_or(&raw)),
         }
-    }
-}
-
-impl<const S: usize> TypedCells<S> {
-    /// Every cell holding a value taken from `raw`: each integer and float its first bytes,
-    /// the boolean bit 0, the string the first `text_len` (at most 8). Harnesses pass symbolic
-    /// bytes, so that "a refused write changes nothing" is checked against any stored value,
-    /// not only against zero.
-    pub fn holding(mut self, raw: [u8; 8], text_len: usize) -> Self {
-        let [b0, b1, b2, b3, ..] = raw;
-        self.boolean = b0 & 1 != 0;
-        self.u8 = b0;
-        self.i8 = b0 as i8;
-        self.u16 = u16::from_le_bytes([b0, b1]);
-        self.i16 = i16::from_le_bytes([b0, b1]);
-        self.u32 = u32::from_le_bytes([b0, b1, b2, b3]);
-        self.i32 = i32::from_le_bytes([b0, b1, b2, b3]);
-        self.f32 = f32::from_le_bytes([b0, b1, b2, b3]);
-        self.u64 = u64::from_le_bytes(raw);
-        self.i64 = i64::from_le_bytes(raw);
-        self.f64 = f64::from_le_bytes(raw);
-        self.bytes = Bytes::from_slice(raw.get(..text_len).unwrap_or(&raw));
-        self
     }
 }
 
