@@ -6,7 +6,7 @@ import os
 import shutil
 import subprocess
 
-from test_e2e_memory1 import COFORGE
+from host import COFORGE
 
 MTOOLS = dict(os.environ, MTOOLS_SKIP_CHECK="1")
 

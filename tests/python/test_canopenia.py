@@ -24,9 +24,8 @@ from simproc import SerialLine, SimProcess
 from qemu import QemuProcess
 import canopen
 import pytest
+from host import COFORGE, ROOT
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 SPEC = ROOT / "spec" / "canopenia.yaml"
 
 NODE_ID = 2

@@ -18,7 +18,7 @@ import subprocess
 import canopen
 import pytest
 
-from test_canopenia import COFORGE, NODE_ID, SPEC, WAIT, Target, encode
+from test_canopenia import COFORGE, SPEC, WAIT, Target
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 VENDOR_401 = (ROOT / "tests" / "vendor-data" / "canopenia" / "CiA401_IO_Node3.bin").read_bytes()

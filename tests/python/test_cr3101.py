@@ -21,7 +21,6 @@ switch, and QEMU refuses a read-only drive as an SD card.
 import datetime
 import os
 import pathlib
-import socket
 import struct
 import subprocess
 import threading
@@ -34,9 +33,8 @@ from bus import Recorder
 from card import MTOOLS, copy_out, fsck_clean, listing, new_card
 from qemu import QemuProcess
 from simproc import SimProcess
+from host import COFORGE, ROOT
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 # Absolute: QEMU runs in a test's own directory, where it keeps the parameter file.
 IMAGE = str(pathlib.Path(os.environ.get("COFORGE_CR3101_QEMU_IMAGE", ROOT / "target" / "dist" / "images" / "cr3101-qemu.bin")).resolve())
 KINDS = ["sim", "qemu"]
@@ -56,15 +54,6 @@ class QemuCr3101(QemuProcess):
         self.monitor_sock = self.console_sock = None
         super().__init__(IMAGE, workdir, uarts=3, extra=["-drive", f"if=sd,format=raw,file={card}"], monitor=True)
 
-    def _connect(self, port, timeout=10.0):
-        deadline = time.monotonic() + timeout
-        while True:
-            try:
-                return socket.create_connection(("127.0.0.1", port), timeout=5.0)
-            except OSError:
-                assert time.monotonic() < deadline, f"QEMU does not listen on port {port}{self.output_note()}"
-                time.sleep(0.05)
-
     def _until(self, sock, done, timeout=10.0):
         """What `sock` sends until `done(text so far)`."""
         data = b""
@@ -83,7 +72,7 @@ class QemuCr3101(QemuProcess):
             return d.endswith(b"(qemu) ")
 
         if self.monitor_sock is None:
-            self.monitor_sock = self._connect(self.monitor_port)
+            self.monitor_sock = self.connect(self.monitor_port)
             self._until(self.monitor_sock, prompt)
         self.monitor_sock.sendall(command.encode() + b"\n")
         out = self._until(self.monitor_sock, lambda d: b"\r\n" in d and prompt(d))
@@ -92,7 +81,7 @@ class QemuCr3101(QemuProcess):
     def console(self, command):
         """Runs a console command on UART2; returns the text after 'ok '."""
         if self.console_sock is None:
-            self.console_sock = self._connect(self.ports[2])
+            self.console_sock = self.connect(self.ports[2])
         self.console_sock.sendall(command.encode() + b"\n")
         line = self._until(self.console_sock, lambda d: d.endswith(b"\n")).decode().strip()
         assert line.startswith("ok "), f"console {command!r}: {line!r}"

@@ -15,9 +15,8 @@ import subprocess
 import pytest
 
 from card import copy_out, fsck_clean, listing, new_card
+from host import ROOT
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 IMAGE = os.environ.get("COFORGE_CARD_QEMU_IMAGE", str(ROOT / "firmware/boards/qemu/target/thumbv7m-none-eabi/release/cr3101-card"))
 
 

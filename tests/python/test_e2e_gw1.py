@@ -30,7 +30,7 @@ from canopen.sdo.exceptions import SdoCommunicationError
 
 from bus import Recorder
 import qemu
-from test_e2e_memory1 import ROOT, connect
+from host import ROOT
 from test_gw1 import EMY0_EMCY, NODE_ID, PRE_OPERATIONAL, SDO_TIMEOUT, WAIT, Host, Sim, X, dictionary, eventually, h
 import canopen
 
@@ -50,7 +50,7 @@ class QemuProcess(qemu.QemuProcess):
         self.pending = b""
         super().__init__(GW1_IMAGE, workdir, uarts=3)
         try:
-            self.pins = connect(self.ports[2])
+            self.pins = self.connect(self.ports[2])
             self.pins.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         except BaseException:
             self.stop()

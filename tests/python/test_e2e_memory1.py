@@ -22,32 +22,15 @@ import canopen
 import pytest
 
 from bus import Recorder
+from host import COFORGE, ROOT, connect
+from qemu import QemuProcess
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 QEMU_IMAGE = os.environ.get("COFORGE_QEMU_IMAGE", str(ROOT / "firmware/boards/qemu/target/thumbv7m-none-eabi/release/co401memory1"))
 # The image that keeps its banks in host files (semihosting), beside the plain one.
 FILES_IMAGE = str(pathlib.Path(QEMU_IMAGE).resolve().with_name(pathlib.Path(QEMU_IMAGE).name.replace("co401memory1", "co401memory1-files", 1)))
 NODE_ID = 5  # the QEMU board's ID pins; the simulator derives its pins from --node-id
 SDO_TIMEOUT = 2.0
 WAIT = 10.0
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def connect(port, timeout=WAIT):
-    deadline = time.monotonic() + timeout
-    while True:
-        try:
-            return socket.create_connection(("127.0.0.1", port), timeout=1)
-        except OSError:
-            if time.monotonic() > deadline:
-                raise
-            time.sleep(0.05)
 
 
 class Target:
@@ -63,33 +46,23 @@ class Target:
             serial = re.search(r"serial host on socket://[\d.]+:(\d+)", self.proc.stdout.readline())
             can = re.search(r"on slcan (socket://\S+)", self.proc.stdout.readline())
             assert serial and can, "coforge sim banner"
-            self.can_url, serial_port = can.group(1), int(serial.group(1))
+            self.can_url = can.group(1)
+            self.serial = connect(int(serial.group(1)))
         else:
-            assert pathlib.Path(image).exists(), f"no QEMU image at {image}: run `cargo xtask test`"
-            serial_port, can_port = free_port(), free_port()
-            self.proc = subprocess.Popen(
-                ["qemu-system-arm", "-machine", "lm3s6965evb", "-nographic", "-monitor", "none",
-                 "-semihosting-config", "enable=on,target=native", "-kernel", image,
-                 "-serial", f"tcp:127.0.0.1:{serial_port},server=on,wait=off,nodelay=on",
-                 "-serial", f"tcp:127.0.0.1:{can_port},server=on,wait=off,nodelay=on"],
-                stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, cwd=cwd,
-            )
-            # The simulator's hub connects to the image's UART1 (an SLCAN adapter of its own
-            # node) and python-canopen joins the hub, as it joins `coforge sim`.
-            self.hub = subprocess.Popen([COFORGE, "hub", "--port", "0", "--connect", f"127.0.0.1:{can_port}"], stdout=subprocess.PIPE, text=True)
-            hub = re.search(r"on slcan (socket://\S+)", self.hub.stdout.readline())
-            assert hub, "coforge hub banner"
-            self.can_url = hub.group(1)
-        self.serial = connect(serial_port)
+            # UART0 is the serial host line; the hub on UART1 is the bus.
+            self.qemu = QemuProcess(image, cwd)
+            self.can_url = self.qemu.can_url
+            self.serial = self.qemu.connect(self.qemu.ports[0])
         self.serial.settimeout(2.0)
         self.serial.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
 
     def close(self):
         self.serial.close()
-        for proc in (getattr(self, "hub", None), self.proc):
-            if proc is not None:
-                proc.kill()
-                proc.wait(timeout=10)
+        if self.kind == "sim":
+            self.proc.kill()
+            self.proc.wait(timeout=10)
+        else:
+            self.qemu.stop()
 
 
 @pytest.fixture(params=["sim", "qemu"])

@@ -3,15 +3,12 @@ tests), and every object and sub-index of the spec appears there with the right 
 access type, name and default, with $NODEID resolved for sample node IDs."""
 
 import json
-import os
-import pathlib
 import subprocess
 
 import canopen
 import pytest
+from host import COFORGE, ROOT
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 SPECS = sorted((ROOT / "spec").glob("*.yaml"))
 NODE_IDS = [1, 0x22, 127]
 

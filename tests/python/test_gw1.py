@@ -24,7 +24,6 @@ pauses are fixed sleeps. Console commands take effect at the chip's next step, s
 for their consequence (a frame, a telegram), not for the console's answer.
 """
 
-import os
 import pathlib
 import re
 import socket
@@ -39,9 +38,8 @@ import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError, SdoCommunicationError
 from serial.urlhandler import protocol_socket
+from host import COFORGE, ROOT
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 SPEC = ROOT / "spec" / "co401gw1.yaml"
 
 NODE_ID = 5

@@ -16,8 +16,6 @@ timeout and periods are checked with generous tolerances.
 
 import binascii
 import json
-import os
-import pathlib
 import re
 import selectors
 import statistics
@@ -28,15 +26,13 @@ import time
 import types
 from dataclasses import dataclass, field
 
-import can
 from bus import Recorder
 import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError, SdoCommunicationError
 from serial.urlhandler import protocol_socket
+from host import COFORGE, ROOT
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 
 # Node-IDs differ per device so that nothing works only for one identifier by accident.
 NODE_ID = {"co401gw1": 5, "cr3101": 0x22, "canopenia": 0x10}

@@ -5,8 +5,6 @@ did not write, for the SDO client in both directions, expedited and segmented, i
 timeout once it has gone; and `coforge sim` devices for scan, NMT and monitor.
 """
 
-import os
-import pathlib
 import re
 import subprocess
 import time
@@ -16,9 +14,8 @@ import canopen
 import pytest
 from serial.urlhandler import protocol_socket
 from simproc import SimProcess
+from host import COFORGE, ROOT
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 
 PEER_ID = 0x21
 

@@ -23,7 +23,6 @@ make 250 ms. Console commands take effect at the module's next step, so tests wa
 consequence (an emergency), not for the console's answer.
 """
 
-import os
 import pathlib
 import re
 import subprocess
@@ -31,16 +30,14 @@ import tempfile
 import time
 import types
 
-import can
 from bus import Recorder
 from simproc import SerialLine, SimProcess
 import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError
 from serial.urlhandler import protocol_socket
+from host import COFORGE, ROOT
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-COFORGE = os.environ.get("COFORGE_BIN", str(ROOT / "target" / "debug" / "coforge"))
 SPEC = ROOT / "spec" / "co401memory1.yaml"
 
 # The simulated board puts this node-ID on the ID0..ID6 pins (--node-id sets the pins).
