@@ -15,3 +15,7 @@ pub mod mmio;
 pub mod sd;
 pub mod serve;
 pub mod uart;
+
+// The memory functions of the STM32F0 images (`firmware/boards/mem`), in place of
+// compiler-builtins' ones.
+use coforge_board_mem as _;
