@@ -34,3 +34,7 @@ pub mod sdo;
 pub mod store;
 pub mod time;
 pub mod value;
+
+// The byte-order types and derives of the generated dictionaries' value structs, re-exported
+// so that a device crate needs no dependency of its own.
+pub use zerocopy;

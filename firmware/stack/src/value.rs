@@ -1,7 +1,15 @@
-//! How typed dictionary fields are read and written as little-endian bytes.
+//! The value types of generated dictionaries, and how app-backed objects' typed values become
+//! bytes.
+//!
+//! A dictionary's stored fields are byte-aligned and little-endian (zerocopy's byte-order
+//! types, [`Bytes`], [`Array`]), so that the struct holding them is the value image
+//! [`crate::od::image`] reads and writes. [`OdValue`] converts the native Rust values of
+//! app-backed objects' hooks (`app::Typed` in the generated code) to and from their bytes.
 
 use crate::od::entry::{Int, le_u64};
 use crate::od::{EntryInfo, ReadLen, SdoAbort, read_slice};
+use zerocopy::little_endian::U16;
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
 
 /// A value stored in a dictionary field. `write` gets data that already passed the access,
 /// length and range checks of [`EntryInfo::check_write`].
@@ -89,11 +97,13 @@ macro_rules! float_value {
 
 float_value!(f32, f64);
 
-/// A string or octet string of at most `N` bytes, stored without heap.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A string, octet string or domain of at most `N` bytes, stored without heap: its length
+/// (2 bytes, little-endian), then the bytes; as [`crate::od::image`] lays out such a value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
+#[repr(C)]
 pub struct Bytes<const N: usize> {
+    len: U16,
     bytes: [u8; N],
-    len: usize,
 }
 
 impl<const N: usize> Bytes<N> {
@@ -108,7 +118,7 @@ impl<const N: usize> Bytes<N> {
             bytes[i] = src[i];
             i += 1;
         }
-        Bytes { bytes, len: i }
+        Bytes { bytes, len: U16::new(i as u16) }
     }
 
     /// The first `N` bytes of `data` (all of them when it is shorter).
@@ -117,20 +127,21 @@ impl<const N: usize> Bytes<N> {
         let len = data.len().min(N);
         if let (Some(dst), Some(src)) = (value.bytes.get_mut(..len), data.get(..len)) {
             dst.copy_from_slice(src);
-            value.len = len;
+            value.len = U16::new(len as u16);
         }
         value
     }
 
+    /// The value (a length beyond `N`, from a corrupt loaded image, reads as all `N` bytes).
     pub fn as_bytes(&self) -> &[u8] {
-        self.bytes.get(..self.len).unwrap_or(&[])
+        self.bytes.get(..usize::from(self.len.get())).unwrap_or(&self.bytes)
     }
 }
 
 /// Empty: what a generated dictionary starts from before it sets the spec's defaults.
 impl<const N: usize> Default for Bytes<N> {
     fn default() -> Self {
-        Bytes { bytes: [0; N], len: 0 }
+        Bytes { bytes: [0; N], len: U16::ZERO }
     }
 }
 
@@ -141,7 +152,7 @@ impl<const N: usize> OdValue for Bytes<N> {
     fn write(&mut self, _: &EntryInfo, data: &[u8]) -> Result<(), SdoAbort> {
         let dst = self.bytes.get_mut(..data.len()).ok_or(SdoAbort::LengthTooHigh)?;
         dst.copy_from_slice(data);
-        self.len = data.len();
+        self.len = U16::new(data.len() as u16);
         Ok(())
     }
 }
@@ -223,8 +234,10 @@ mod tests {
     }
 }
 
-/// An ARRAY object's storage: sub 0 and the elements 1..=N.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// An ARRAY object's storage: sub 0 and the elements 1..=N (byte-aligned types: no padding
+/// between them, as the value image has it).
+#[derive(Debug, Clone, Copy, PartialEq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
+#[repr(C, packed)]
 pub struct Array<T, const N: usize> {
     pub sub0: u8,
     pub items: [T; N],
@@ -237,232 +250,3 @@ impl<T: Default + Copy, const N: usize> Default for Array<T, N> {
     }
 }
 
-impl<T: OdValue, const N: usize> Array<T, N> {
-    /// The field of sub-index `sub`: 0 the count, 1..=N the items (the generated dispatch
-    /// routes every sub-index of an array here, one arm per array).
-    #[inline]
-    pub fn sub(&mut self, sub: u8) -> Option<&mut dyn OdValue> {
-        array_sub(&mut self.sub0, &mut self.items, sub)
-    }
-}
-
-/// [`Array::sub`] for any length: one copy per item type, not one per array object (the
-/// dispatch has one arm per array).
-#[inline(never)]
-fn array_sub<'a, T: OdValue>(sub0: &'a mut u8, items: &'a mut [T], sub: u8) -> Option<&'a mut dyn OdValue> {
-    match sub.checked_sub(1) {
-        None => Some(sub0),
-        Some(i) => items.get_mut(usize::from(i)).map(|v| v as &mut dyn OdValue),
-    }
-}
-
-/// A field's fixed-size image in the 1010h/1011h store: what `save` writes, `load` reads.
-pub trait Persist {
-    /// Bytes of the image.
-    const SIZE: usize;
-    fn save(&self, out: &mut [u8]);
-    fn load(&mut self, data: &[u8]);
-}
-
-macro_rules! persist_number {
-    ($($t:ty),*) => {$(
-        impl Persist for $t {
-            const SIZE: usize = core::mem::size_of::<$t>();
-            fn save(&self, out: &mut [u8]) {
-                if let Some(dst) = out.get_mut(..Self::SIZE) {
-                    dst.copy_from_slice(&self.to_le_bytes());
-                }
-            }
-            fn load(&mut self, data: &[u8]) {
-                if let Some(bytes) = data.get(..Self::SIZE).and_then(|b| b.try_into().ok()) {
-                    *self = <$t>::from_le_bytes(bytes);
-                }
-            }
-        }
-    )*};
-}
-
-persist_number!(u8, u16, u32, u64, i8, i16, i32, i64, f32, f64);
-
-impl Persist for bool {
-    const SIZE: usize = 1;
-    fn save(&self, out: &mut [u8]) {
-        if let Some(b) = out.first_mut() {
-            *b = u8::from(*self);
-        }
-    }
-    fn load(&mut self, data: &[u8]) {
-        if let Some(&b) = data.first() {
-            *self = b != 0;
-        }
-    }
-}
-
-/// Strings: a 2-byte length, then `N` bytes.
-impl<const N: usize> Persist for Bytes<N> {
-    const SIZE: usize = 2 + N;
-    fn save(&self, out: &mut [u8]) {
-        let len = u16::try_from(self.len).unwrap_or(u16::MAX);
-        if let Some(l) = out.get_mut(..2) {
-            l.copy_from_slice(&len.to_le_bytes());
-        }
-        if let Some(b) = out.get_mut(2..2 + N) {
-            b.copy_from_slice(&self.bytes);
-        }
-    }
-    fn load(&mut self, data: &[u8]) {
-        let (Some(&[l0, l1]), Some(b)) = (data.get(..2).and_then(|l| <&[u8; 2]>::try_from(l).ok()), data.get(2..2 + N)) else { return };
-        let len = usize::from(u16::from_le_bytes([l0, l1]));
-        if len <= N {
-            self.bytes.copy_from_slice(b);
-            self.len = len;
-        }
-    }
-}
-
-/// One unit of the persistent block as the generated `save_area`/`load_area` walk it: a field,
-/// an array's items, a whole array or a whole record, each handing its entries' images over
-/// one by one at their offsets (the same pieces, in the same order, as a walk entry by entry).
-/// Object-safe, so a dictionary names its units in one `match` instead of unrolling a copy of
-/// the store code per entry.
-pub trait Persistent {
-    /// Hands the image of every entry of the unit to `sink`, the first at offset `at`; `false`
-    /// if `sink` refused one (the rest are still handed over).
-    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool;
-    /// Loads every entry of the unit from `source`, the first at offset `at`; an entry whose
-    /// image `source` cannot give keeps its value, and the result is `false`.
-    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool;
-}
-
-macro_rules! persistent_number {
-    ($($t:ty),*) => {$(
-        // Out of line: records call these once per field.
-        impl Persistent for $t {
-            #[inline(never)]
-            fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-                sink(at, &self.to_le_bytes())
-            }
-            #[inline(never)]
-            fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-                let mut image = [0_u8; size_of::<$t>()];
-                let ok = source(at, &mut image);
-                if ok {
-                    *self = <$t>::from_le_bytes(image);
-                }
-                ok
-            }
-        }
-    )*};
-}
-
-persistent_number!(u8, u16, u32, u64, i8, i16, i32, i64, f32, f64);
-
-impl Persistent for bool {
-    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-        sink(at, &[u8::from(*self)])
-    }
-    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-        let mut image = [0_u8; 1];
-        let ok = source(at, &mut image);
-        if ok {
-            self.load(&image);
-        }
-        ok
-    }
-}
-
-/// The length (2 bytes), then the `N` bytes: [`Persist`]'s image, in two pieces.
-impl<const N: usize> Persistent for Bytes<N> {
-    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-        let len = u16::try_from(self.len).unwrap_or(u16::MAX);
-        let ok = sink(at, &len.to_le_bytes());
-        sink(at + 2, &self.bytes) && ok
-    }
-    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-        let (mut len, mut bytes) = ([0_u8; 2], [0_u8; N]);
-        let ok = source(at, &mut len) && source(at + 2, &mut bytes);
-        let len = usize::from(u16::from_le_bytes(len));
-        // A corrupt length leaves the value as it was.
-        if ok && len <= N {
-            (self.bytes, self.len) = (bytes, len);
-        }
-        ok
-    }
-}
-
-/// An array's items 1..=N, each [`Persist::SIZE`] bytes.
-impl<T: Persist + Persistent, const N: usize> Persistent for [T; N] {
-    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-        let mut ok = true;
-        for (i, item) in self.iter().enumerate() {
-            ok &= item.save_to(at + i * T::SIZE, sink);
-        }
-        ok
-    }
-    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-        let mut ok = true;
-        for (i, item) in self.iter_mut().enumerate() {
-            ok &= item.load_from(at + i * T::SIZE, source);
-        }
-        ok
-    }
-}
-
-/// A whole array: sub 0, then the items.
-impl<T: Persist + Persistent, const N: usize> Persistent for Array<T, N> {
-    fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-        let ok = self.sub0.save_to(at, sink);
-        self.items.save_to(at + 1, sink) && ok
-    }
-    fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-        let ok = self.sub0.load_from(at, source);
-        self.items.load_from(at + 1, source) && ok
-    }
-}
-
-/// A generated record's fields, one after the other from `at`, each with its image size: one
-/// loop for every record type instead of a call sequence per type.
-#[inline(never)]
-pub fn save_fields(fields: &[(&dyn Persistent, usize)], mut at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-    let mut ok = true;
-    for &(field, size) in fields {
-        ok &= field.save_to(at, sink);
-        at += size;
-    }
-    ok
-}
-
-/// Loads a generated record's fields ([`save_fields`]).
-#[inline(never)]
-pub fn load_fields(fields: &mut [(&mut dyn Persistent, usize)], mut at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-    let mut ok = true;
-    for (field, size) in fields {
-        ok &= field.load_from(at, source);
-        at += *size;
-    }
-    ok
-}
-
-#[cfg(test)]
-mod persist_tests {
-    use super::*;
-
-    #[test]
-    fn images_round_trip() {
-        let mut out = [0_u8; 16];
-        0x1234_u16.save(&mut out);
-        let mut v = 0_u16;
-        v.load(&out);
-        assert_eq!(v, 0x1234);
-        let s = Bytes::<8>::new("oil");
-        s.save(&mut out);
-        assert_eq!(out[..5], [3, 0, b'o', b'i', b'l']);
-        let mut t = Bytes::<8>::new("");
-        t.load(&out);
-        assert_eq!(t.as_bytes(), b"oil");
-        // A corrupt length leaves the value as it was.
-        out[0] = 200;
-        t.load(&out);
-        assert_eq!(t.as_bytes(), b"oil");
-    }
-}

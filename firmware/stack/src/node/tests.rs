@@ -10,8 +10,8 @@ use crate::od::{
     Access, AppObjects, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NodeDictionary, ReadLen, SdoAbort,
     Side, Storage, WriteSource, read_slice,
 };
+use crate::od::image::{Patch, Span};
 use crate::store::NoStore;
-use crate::value::OdValue;
 use coforge_types::NmtState;
 extern crate std;
 use std::vec;
@@ -27,7 +27,7 @@ const fn entry(index: u16, sub: u8, data_type: DataType, access: Access) -> Entr
     let flags = EntryFlags::new(HostAccess::Rw, Storage::Ram);
     EntryInfo {
         index,
-        object: 0,
+        offset: 0,
         size,
         sub,
         last_sub: sub,
@@ -80,13 +80,62 @@ const TABLE: [(EntryInfo, u32, bool); ENTRY_COUNT] = [
     (entry(0x2102, 0, U8, Access::Ro), 1, false),
 ];
 
+/// Bytes of each entry's slot in the value image: entry `i` lives at `4 * i`.
+const SLOT: usize = 4;
+const IMAGE: usize = SLOT * ENTRY_COUNT;
+
 static ENTRIES: [EntryInfo; ENTRY_COUNT] = {
     let mut out = [entry(0, 0, U8, Access::Ro); ENTRY_COUNT];
     let mut i = 0;
     while i < out.len() {
         out[i] = TABLE[i].0;
+        out[i].offset = (SLOT * i) as u16;
         i += 1;
     }
+    out
+};
+
+/// The defaults' image: each default little-endian in its slot (a byte entry reads its first
+/// byte), the `$NODEID` ones as patches.
+static DEFAULTS: [u8; IMAGE] = {
+    let mut out = [0; IMAGE];
+    let mut i = 0;
+    while i < ENTRY_COUNT {
+        let bytes = TABLE[i].1.to_le_bytes();
+        let mut b = 0;
+        while b < SLOT {
+            out[SLOT * i + b] = bytes[b];
+            b += 1;
+        }
+        i += 1;
+    }
+    out
+};
+
+/// One span per slot: each has its entry's index, so a reset of an area takes exactly its
+/// entries.
+static SPANS: [Span; ENTRY_COUNT] = {
+    let mut out = [Span { index: 0, start: 0, len: 0 }; ENTRY_COUNT];
+    let mut i = 0;
+    while i < ENTRY_COUNT {
+        out[i] = Span { index: TABLE[i].0.index, start: (SLOT * i) as u16, len: SLOT as u16 };
+        i += 1;
+    }
+    out
+};
+
+/// The entries whose default adds the node-ID (1400h.1 and 1800h.1).
+static NODE_ID_DEFAULTS: [Patch; 2] = {
+    let mut out = [Patch { index: 0, at: 0, width: 0, plus_node_id: true, value: 0 }; 2];
+    let (mut i, mut n) = (0, 0);
+    while i < ENTRY_COUNT {
+        if TABLE[i].2 {
+            out[n] = Patch { index: TABLE[i].0.index, at: (SLOT * i) as u16, width: 4, plus_node_id: true, value: TABLE[i].1 };
+            n += 1;
+        }
+        i += 1;
+    }
+    assert!(n == out.len(), "every $NODEID entry has its patch");
     out
 };
 
@@ -141,11 +190,10 @@ impl AppObjects for Recorder {
     }
 }
 
-/// The test dictionary: each entry's value in a byte or a word, by its place in the table.
+/// The test dictionary: each entry's value in its slot of the image.
 #[derive(Debug)]
 pub(super) struct TestOd {
-    bytes: [u8; ENTRY_COUNT],
-    words: [u32; ENTRY_COUNT],
+    image: [u8; IMAGE],
     emergencies: &'static [EmcyDefault],
     app: Recorder,
 }
@@ -161,9 +209,12 @@ impl EntryAccess for TestOd {
         &[]
     }
 
-    fn field(&mut self, info: &EntryInfo, sub: u8) -> Option<&mut dyn OdValue> {
-        let at = ENTRIES.iter().position(|e| e.index == info.index && e.sub == sub)?;
-        if info.size == 1 { Some(&mut self.bytes[at]) } else { Some(&mut self.words[at]) }
+    fn image(&self) -> &[u8] {
+        &self.image
+    }
+
+    fn image_mut(&mut self) -> &mut [u8] {
+        &mut self.image
     }
 
     fn app(&mut self) -> &mut Recorder {
@@ -174,26 +225,15 @@ impl EntryAccess for TestOd {
 impl NodeDictionary for TestOd {
     type Mode = ();
     const MODES: &'static [()] = &[()];
-    const PERSISTENT_SIZE: usize = 0;
+    const PERSISTENT: &'static [Span] = &[];
+    const STORED: &'static [Span] = &SPANS;
+    const DEFAULTS: &'static [u8] = &DEFAULTS;
+    const NODE_ID_DEFAULTS: &'static [Patch] = &NODE_ID_DEFAULTS;
     const SDO_BLOCK_TRANSFER: bool = false;
     const COMM: CommObjects = CommObjects { error_history: false, sync_cycle: false, heartbeat_consumer: true };
 
-    fn save_area(&self, _: Area, _: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-        true
-    }
-
-    fn load_area(&mut self, _: Area, _: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-        true
-    }
-
-    fn reset_area(&mut self, area: Area, node_id: u8) {
-        for (at, (info, default, plus_id)) in TABLE.iter().enumerate() {
-            if area.contains(info.index) {
-                let value = default + if *plus_id { u32::from(node_id) } else { 0 };
-                self.bytes[at] = value as u8;
-                self.words[at] = value;
-            }
-        }
+    fn mode_defaults(&self) -> &'static [Patch] {
+        &[]
     }
 
     fn emergencies(&self) -> &'static [EmcyDefault] {
@@ -205,7 +245,7 @@ impl NodeDictionary for TestOd {
     }
 
     fn new(_: (), node_id: u8, app: Recorder) -> Self {
-        let mut od = TestOd { bytes: [0; ENTRY_COUNT], words: [0; ENTRY_COUNT], emergencies: &[], app };
+        let mut od = TestOd { image: [0; IMAGE], emergencies: &[], app };
         od.reset_area(Area::ALL, node_id);
         od
     }

@@ -1,15 +1,15 @@
 //! The traits generated dictionaries implement: entry access (`EntryAccess`), what a node
 //! needs beyond it (`NodeDictionary`), and the owner of app-backed objects (`AppObjects`).
 
-use super::{AccessContext, EntryInfo, Limits, ReadLen, SdoAbort, Side, WriteSource, find};
-use crate::value::OdValue;
+use super::{AccessContext, EntryInfo, Limits, ReadLen, SdoAbort, Side, WriteSource, find, image};
 use coforge_types::Storage;
 
 /// The dictionary of one device: implemented by the code `device!` generates.
 ///
-/// The generated code provides the table and the field of each stored entry (`field`);
-/// reads, writes, lookups and access checks are the provided methods, so every device
-/// refuses the same accesses with the same codes and the dispatch code exists once.
+/// The generated code provides the table and the value image its entries point into
+/// (`image`, `image_mut`); reads, writes, lookups and access checks are the provided
+/// methods, so every device refuses the same accesses with the same codes and the access
+/// code exists once.
 pub trait EntryAccess {
     /// Where app-backed entries (`storage: app`) are read and written.
     type App: AppObjects;
@@ -20,10 +20,12 @@ pub trait EntryAccess {
     /// The value limits the entries' `limits` indices refer to.
     fn limits(&self) -> &'static [Limits];
 
-    /// The field that stores `sub` of the entry `info` describes, `info` being the run
-    /// [`find_run`] gave for it (so `info.covers(sub)`; single-entry objects do not look at
-    /// `sub` again); `None` for an entry the dictionary does not store (app-backed ones).
-    fn field(&mut self, info: &EntryInfo, sub: u8) -> Option<&mut dyn OdValue>;
+    /// The values of every stored (RAM and persistent) entry, as [`image`] lays them out:
+    /// each entry's `offset` points in here.
+    fn image(&self) -> &[u8];
+
+    /// [`EntryAccess::image`], to write.
+    fn image_mut(&mut self) -> &mut [u8];
 
     /// The device's app-backed objects.
     fn app(&mut self) -> &mut Self::App;
@@ -34,7 +36,7 @@ pub trait EntryAccess {
         if info.storage() == Storage::App {
             return self.app().read(info, index, sub, offset, buf);
         }
-        self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.read(info, offset, buf)
+        image::read(self.image(), info, sub, offset, buf)
     }
 
     /// Writes `data` (the whole value, little-endian) after its length and value checks; no
@@ -44,7 +46,7 @@ pub trait EntryAccess {
         if info.storage() == Storage::App {
             return self.app().write(info, index, sub, data);
         }
-        self.field(info, sub).ok_or(SdoAbort::NoSubIndex)?.write(info, data)
+        image::write(self.image_mut(), info, sub, data)
     }
 
     /// The entry's metadata, or `NoObject` / `NoSubIndex`.
@@ -129,8 +131,23 @@ pub trait NodeDictionary: EntryAccess {
     /// Every mode, the spec's first (the default) first.
     const MODES: &'static [Self::Mode];
 
-    /// Bytes of the persistent block (every `storage: persistent` entry, index order).
-    const PERSISTENT_SIZE: usize;
+    /// The persistent block: the spans of the value image that hold `storage: persistent`
+    /// entries, in index order, whatever the mode (a block saved in one mode loads in another).
+    const PERSISTENT: &'static [image::Span];
+
+    /// Bytes of the persistent block.
+    const PERSISTENT_SIZE: usize = image::block_len(Self::PERSISTENT);
+
+    /// The spans of the value image a reset of an area sets back to [`NodeDictionary::DEFAULTS`]:
+    /// every stored entry, split where the index class changes.
+    const STORED: &'static [image::Span];
+
+    /// The value image of the spec's defaults (the first mode's where they differ), before
+    /// [`NodeDictionary::NODE_ID_DEFAULTS`] and [`NodeDictionary::mode_defaults`].
+    const DEFAULTS: &'static [u8];
+
+    /// The defaults that depend on the node-ID, in every mode.
+    const NODE_ID_DEFAULTS: &'static [image::Patch];
 
     /// Whether the SDO server does block transfer (the spec's `sdo_block_transfer`).
     const SDO_BLOCK_TRANSFER: bool;
@@ -138,17 +155,30 @@ pub trait NodeDictionary: EntryAccess {
     /// The optional communication objects the dictionary has in any mode.
     const COMM: CommObjects;
 
+    /// The defaults of the dictionary's mode that differ from [`NodeDictionary::DEFAULTS`].
+    fn mode_defaults(&self) -> &'static [image::Patch];
+
     /// Hands the image of every persistent entry of `area` to `sink` with its offset in the
     /// block, so the block is written without a buffer of its size; `false` if `sink` failed.
-    fn save_area(&self, area: Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool;
+    fn save_area(&self, area: Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
+        image::save(self.image(), Self::PERSISTENT, area, sink)
+    }
 
-    /// Loads every persistent entry of `area` from `source` (offset, buffer to fill); an entry
-    /// whose image `source` cannot give keeps its value, and the result is `false`.
-    fn load_area(&mut self, area: Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool;
+    /// Loads every persistent entry of `area` from `source` (offset, buffer to fill); a piece
+    /// `source` cannot give keeps its bytes, and the result is `false`.
+    fn load_area(&mut self, area: Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
+        image::load(self.image_mut(), Self::PERSISTENT, area, source)
+    }
 
     /// Sets every stored entry (RAM and persistent) of `area` back to its spec default,
     /// `$NODEID` resolved for `node_id`. App-backed entries are the device's business.
-    fn reset_area(&mut self, area: Area, node_id: u8);
+    fn reset_area(&mut self, area: Area, node_id: u8) {
+        let patches = self.mode_defaults();
+        let image = self.image_mut();
+        image::reset(image, Self::DEFAULTS, Self::STORED, area);
+        image::patch(image, Self::NODE_ID_DEFAULTS, area, node_id);
+        image::patch(image, patches, area, node_id);
+    }
 
     /// The spec's emergencies in the dictionary's mode.
     fn emergencies(&self) -> &'static [crate::emcy::EmcyDefault];

@@ -20,9 +20,10 @@ pub struct Limits {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EntryInfo {
     pub index: u16,
-    /// The number of the object in the generated dictionary, dense from 0 and the same in
-    /// every mode: what its field dispatch switches on, so the switch is a jump table.
-    pub object: u16,
+    /// Where the value of sub-index `sub` starts in the dictionary's value image
+    /// ([`image`](super::image)); the run's further sub-indices follow at
+    /// [`image::stride`](super::image::stride). Unused (0) for app-backed entries.
+    pub offset: u16,
     /// Size in bytes; for strings and domains the maximum.
     pub size: u16,
     /// First sub-index this description covers.
@@ -404,7 +405,7 @@ pub fn decode_int(data_type: DataType, data: &[u8]) -> Option<i128> {
 pub(crate) const fn test_entry(data_type: DataType, access: Access, host_access: HostAccess, size: u16) -> EntryInfo {
     EntryInfo {
         index: 0x2000,
-        object: 0,
+        offset: 0,
         size,
         sub: 0,
         last_sub: 0,

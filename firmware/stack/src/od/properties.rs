@@ -8,8 +8,7 @@
 //! refused write changes nothing.
 #![allow(clippy::panic)]
 
-use super::{Access, AccessContext, DataType, EntryAccess, EntryInfo, HostAccess, Limits, NoAppObjects, SdoAbort, Side, Storage};
-use crate::value::{Bytes, OdValue};
+use super::{Access, AccessContext, EntryAccess, EntryInfo, HostAccess, Limits, NoAppObjects, SdoAbort, Side, Storage};
 
 /// The longest value the properties read back.
 const BUF: usize = 16;
@@ -102,63 +101,29 @@ pub fn prop_read_is_checked<D: EntryAccess>(od: &mut D, index: u16, sub: u8, sid
     }
 }
 
-/// A dictionary with a generated table and, in place of the generated fields, one cell per
-/// Rust type a field of that data type has (`rust_type` in the generator: 24-bit integers in
-/// `u32`/`i32`, strings and domains in `Bytes`, of `S` bytes here). The Kani write harnesses
-/// prove [`prop_write_is_checked`] on it: symbolic execution of a write into the whole
-/// generated struct through `&mut dyn OdValue` did not end (see verification/README.md), while
-/// the lookup, the access, length and value checks and every `OdValue` write are the real
-/// code here. That the generated fields behave as these cells do, entry by entry, is a test
-/// (`tests/dictionary_properties.rs` in the verification crate).
-///
-/// Entries of one type share a cell: the properties only read back the entry just written.
+/// A dictionary with a generated table over a value image of `S` bytes (the generated
+/// dictionary's size) holding any bytes, without the device's app-backed objects. The Kani
+/// write harnesses prove [`prop_write_is_checked`] on it: the lookup, the access, length and
+/// value checks and the image writes are the real code, the image's bytes symbolic; the
+/// app-backed entries (whose owners serve them, not the dictionary) answer as absent.
 #[derive(Debug, Clone, PartialEq)]
-pub struct TypedCells<const S: usize> {
+pub struct ImageCells<const S: usize> {
     entries: &'static [EntryInfo],
     limits: &'static [Limits],
     app: NoAppObjects,
-    boolean: bool,
-    u8: u8,
-    u16: u16,
-    u32: u32,
-    u64: u64,
-    i8: i8,
-    i16: i16,
-    i32: i32,
-    i64: i64,
-    f32: f32,
-    f64: f64,
-    bytes: Bytes<S>,
+    image: [u8; S],
 }
 
-impl<const S: usize> TypedCells<S> {
-    /// The table (and limits) of `od`, every cell holding a value taken from `raw`: each
-    /// integer and float its first bytes, the boolean bit 0, the string the first `text_len`
-    /// (at most 8). Harnesses pass symbolic bytes, so that "a refused write changes nothing"
-    /// is checked against any stored value, not only against zero.
-    pub fn over<D: EntryAccess>(od: &D, raw: [u8; 8], text_len: usize) -> Self {
-        let [b0, b1, b2, b3, ..] = raw;
-        TypedCells {
-            entries: od.entries(),
-            limits: od.limits(),
-            app: NoAppObjects,
-            boolean: b0 & 1 != 0,
-            u8: b0,
-            u16: u16::from_le_bytes([b0, b1]),
-            u32: u32::from_le_bytes([b0, b1, b2, b3]),
-            u64: u64::from_le_bytes(raw),
-            i8: b0 as i8,
-            i16: i16::from_le_bytes([b0, b1]),
-            i32: i32::from_le_bytes([b0, b1, b2, b3]),
-            i64: i64::from_le_bytes(raw),
-            f32: f32::from_le_bytes([b0, b1, b2, b3]),
-            f64: f64::from_le_bytes(raw),
-            bytes: Bytes::from_slice(raw.get(..text_len).unwrap_or(&raw)),
-        }
+impl<const S: usize> ImageCells<S> {
+    /// The table (and limits) of `od` over `image`. Harnesses pass symbolic bytes, so that "a
+    /// refused write changes nothing" is checked against any stored value, not only against
+    /// the defaults.
+    pub fn over<D: EntryAccess>(od: &D, image: [u8; S]) -> Self {
+        ImageCells { entries: od.entries(), limits: od.limits(), app: NoAppObjects, image }
     }
 }
 
-impl<const S: usize> EntryAccess for TypedCells<S> {
+impl<const S: usize> EntryAccess for ImageCells<S> {
     type App = NoAppObjects;
 
     fn entries(&self) -> &'static [EntryInfo] {
@@ -169,25 +134,12 @@ impl<const S: usize> EntryAccess for TypedCells<S> {
         self.limits
     }
 
-    fn field(&mut self, info: &EntryInfo, _: u8) -> Option<&mut dyn OdValue> {
-        use DataType::*;
-        if info.storage() == Storage::App {
-            return None;
-        }
-        Some(match info.data_type() {
-            Boolean => &mut self.boolean,
-            Unsigned8 => &mut self.u8,
-            Unsigned16 => &mut self.u16,
-            Unsigned24 | Unsigned32 => &mut self.u32,
-            Unsigned40 | Unsigned48 | Unsigned56 | Unsigned64 => &mut self.u64,
-            Integer8 => &mut self.i8,
-            Integer16 => &mut self.i16,
-            Integer24 | Integer32 => &mut self.i32,
-            Integer40 | Integer48 | Integer56 | Integer64 => &mut self.i64,
-            Real32 => &mut self.f32,
-            Real64 => &mut self.f64,
-            VisibleString | OctetString | UnicodeString | Domain | TimeOfDay | TimeDifference => &mut self.bytes,
-        })
+    fn image(&self) -> &[u8] {
+        &self.image
+    }
+
+    fn image_mut(&mut self) -> &mut [u8] {
+        &mut self.image
     }
 
     fn app(&mut self) -> &mut NoAppObjects {
