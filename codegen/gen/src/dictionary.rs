@@ -1,7 +1,10 @@
-//! The typed dictionary: `Od<A>` with one field per RAM/persistent object (app-backed entries
-//! go to `A: AppObjects`), `Od::new` with the spec's defaults (`$NODEID` resolved), and the
-//! `EntryAccess` implementation: `field` is one generated `match` on the entry's dense
-//! object number, so reads and writes share one jump table and their code lives in the stack.
+//! The typed dictionary: `Values`, one `#[repr(C)]` struct of byte-aligned little-endian
+//! fields for every RAM and persistent object (app-backed entries go to `A: AppObjects`),
+//! which is at the same time the value image every `EntryInfo::offset` points into; `Od<A>`
+//! around it; the spec's defaults as a value image (`DEFAULT_VALUES`) with patches for what
+//! depends on the node-ID or the mode; the spans that NMT resets and the 1010h store act on.
+//! Reads, writes, resets, saves and loads are the stack's (`coforge_stack::od::image`), once
+//! for every device: nothing here dispatches per object.
 
 use crate::Options;
 use crate::modes::Modes;
@@ -15,46 +18,15 @@ use std::collections::BTreeMap;
 /// One index, merged over every mode it exists in.
 struct Slot<'a> {
     index: u16,
-    /// Dense object number ([`object_numbers`]).
-    number: u16,
     object: &'a Object,
     /// sub -> the entry (first mode wins for types).
     entries: BTreeMap<u8, &'a Entry>,
 }
 
-/// The spec default of an entry in each mode it exists in: `(mode variant, default tokens)`.
-type ModeDefaults = Vec<(Ident, TokenStream)>;
-
-/// The default of `index`/`sub` in every mode, in the field's Rust type.
-fn mode_defaults(d: &Device, modes: &Modes, index: u16, sub: u8, stack: &TokenStream) -> ModeDefaults {
-    let mut out = Vec::new();
-    for (variant, mode) in &modes.variants {
-        let entry = d
-            .objects
-            .iter()
-            .filter(|o| o.index == index && in_mode(&o.modes, mode.as_deref()))
-            .flat_map(|o| &o.entries)
-            .find(|e| e.sub == sub && in_mode(&e.modes, mode.as_deref()));
-        if let Some(e) = entry {
-            out.push((variant.clone(), initial(e, stack)));
-        }
-    }
-    out
-}
-
-/// Every index of the device, in every mode, numbered densely in index order: the
-/// `EntryInfo::object` the table carries and the `field` dispatch switches on.
-pub(crate) fn object_numbers(d: &Device) -> BTreeMap<u16, u16> {
-    let indices: std::collections::BTreeSet<u16> = d.objects.iter().map(|o| o.index).collect();
-    indices.into_iter().zip(0..).collect()
-}
-
 fn slots(d: &Device) -> Vec<Slot<'_>> {
-    let numbers = object_numbers(d);
     let mut map: BTreeMap<u16, Slot<'_>> = BTreeMap::new();
     for o in &d.objects {
-        let number = numbers.get(&o.index).copied().unwrap_or_default();
-        let slot = map.entry(o.index).or_insert_with(|| Slot { index: o.index, number, object: o, entries: BTreeMap::new() });
+        let slot = map.entry(o.index).or_insert_with(|| Slot { index: o.index, object: o, entries: BTreeMap::new() });
         for e in &o.entries {
             slot.entries.entry(e.sub).or_insert(e);
         }
@@ -62,7 +34,7 @@ fn slots(d: &Device) -> Vec<Slot<'_>> {
     map.into_values().collect()
 }
 
-/// The Rust type of an entry's field.
+/// The native Rust type of an entry's value: what app-backed objects' hooks take and give.
 pub(crate) fn rust_type(e: &Entry, stack: &TokenStream) -> TokenStream {
     match e.data_type {
         DataType::Boolean => quote!(bool),
@@ -76,43 +48,105 @@ pub(crate) fn rust_type(e: &Entry, stack: &TokenStream) -> TokenStream {
         DataType::Integer40 | DataType::Integer48 | DataType::Integer56 | DataType::Integer64 => quote!(i64),
         DataType::Real32 => quote!(f32),
         DataType::Real64 => quote!(f64),
-        DataType::VisibleString | DataType::OctetString | DataType::UnicodeString | DataType::Domain | DataType::TimeOfDay | DataType::TimeDifference => {
-            let n = crate::dec(u64::from(crate::entries::size_of(e)));
-            quote!(#stack::value::Bytes<#n>)
-        }
+        _ => bytes_type(e, stack),
     }
 }
 
-/// The spec default of an entry's field; `node_id` is in scope in `reset_area`.
-fn initial(e: &Entry, stack: &TokenStream) -> TokenStream {
-    let ty = rust_type(e, stack);
-    match (&e.default, e.data_type) {
-        // Evaluated at compile time: a copy from flash, not a call that fills the text in.
-        (Some(Value::Str(s)), _) => quote!(const { #stack::value::Bytes::new(#s) }),
-        (_, t) if t.int_range().is_none() && !t.is_real() => quote!(const { #stack::value::Bytes::new("") }),
-        (Some(Value::Real(x)), _) => quote!(#x as #ty),
-        (None, DataType::Boolean) => quote!(false),
-        (Some(Value::Int(expr)), DataType::Boolean) => {
-            let b = expr.eval(&Default::default(), Some(1)).unwrap_or(0) != 0;
-            quote!(#b)
-        }
-        (None, t) if t.is_real() => quote!(0.0),
-        (None, _) => quote!(0),
-        (Some(Value::Int(expr)), t) if t.is_real() => {
-            let v = expr.eval(&Default::default(), Some(1)).unwrap_or(0) as f64;
-            quote!(#v as #ty)
-        }
-        (Some(Value::Int(expr)), _) => match expr.node_id_offset() {
-            Ok(Some(base)) => {
-                let base = literal(base);
-                quote!((node_id as #ty).wrapping_add(#base))
+fn bytes_type(e: &Entry, stack: &TokenStream) -> TokenStream {
+    let n = crate::dec(u64::from(crate::entries::size_of(e)));
+    quote!(#stack::value::Bytes<#n>)
+}
+
+/// The type of an entry's field in `Values`: exactly the entry's bytes, little-endian and
+/// byte-aligned, so that the struct is the value image (`BOOLEAN` one byte, 0 or 1; 24-, 40-,
+/// 48- and 56-bit integers their bytes; strings and domains their length, then their bytes).
+fn image_type(e: &Entry, stack: &TokenStream) -> TokenStream {
+    let zc = quote!(#stack::zerocopy::little_endian);
+    match e.data_type {
+        DataType::Boolean | DataType::Unsigned8 => quote!(u8),
+        DataType::Integer8 => quote!(i8),
+        DataType::Unsigned16 => quote!(#zc::U16),
+        DataType::Unsigned32 => quote!(#zc::U32),
+        DataType::Unsigned64 => quote!(#zc::U64),
+        DataType::Integer16 => quote!(#zc::I16),
+        DataType::Integer32 => quote!(#zc::I32),
+        DataType::Integer64 => quote!(#zc::I64),
+        DataType::Real32 => quote!(#zc::F32),
+        DataType::Real64 => quote!(#zc::F64),
+        t => match t.bits() {
+            Some(bits) => {
+                let n = crate::dec(u64::from(bits / 8));
+                quote!([u8; #n])
             }
-            _ => literal(expr.eval(&Default::default(), None).unwrap_or(0)),
+            None => bytes_type(e, stack),
         },
     }
 }
 
-/// An integer literal the field's type is inferred for: hex from 10 up, like the datasheets.
+/// An entry's spec default, as the value image needs it.
+#[derive(Debug, Clone, PartialEq)]
+enum Init {
+    Int(i64),
+    /// `$NODEID + base`: the image holds `base`, a patch adds the node-ID.
+    NodeId(i64),
+    Real(f64),
+    Str(String),
+}
+
+fn default_of(e: &Entry) -> Init {
+    match (&e.default, e.data_type) {
+        (Some(Value::Str(s)), _) => Init::Str(s.clone()),
+        (_, t) if t.int_range().is_none() && !t.is_real() => Init::Str(String::new()),
+        (Some(Value::Real(x)), _) => Init::Real(*x),
+        (None, t) if t.is_real() => Init::Real(0.0),
+        (None, _) => Init::Int(0),
+        (Some(Value::Int(expr)), DataType::Boolean) => Init::Int(i64::from(expr.eval(&Default::default(), Some(1)).unwrap_or(0) != 0)),
+        (Some(Value::Int(expr)), t) if t.is_real() => Init::Real(expr.eval(&Default::default(), Some(1)).unwrap_or(0) as f64),
+        (Some(Value::Int(expr)), _) => match expr.node_id_offset() {
+            Ok(Some(base)) => Init::NodeId(base),
+            _ => Init::Int(expr.eval(&Default::default(), None).unwrap_or(0)),
+        },
+    }
+}
+
+/// The default of `index`/`sub` in every mode it exists in: `(mode variant, default)`.
+fn mode_defaults(d: &Device, modes: &Modes, index: u16, sub: u8) -> Vec<(Ident, Init)> {
+    let mut out = Vec::new();
+    for (variant, mode) in &modes.variants {
+        let entry = d
+            .objects
+            .iter()
+            .filter(|o| o.index == index && in_mode(&o.modes, mode.as_deref()))
+            .flat_map(|o| &o.entries)
+            .find(|e| e.sub == sub && in_mode(&e.modes, mode.as_deref()));
+        if let Some(e) = entry {
+            out.push((variant.clone(), default_of(e)));
+        }
+    }
+    out
+}
+
+/// `v` as a constant of the image type `ty` of entry `e`.
+fn constant(e: &Entry, ty: &TokenStream, v: &Init, stack: &TokenStream) -> TokenStream {
+    match v {
+        Init::Str(s) => quote!(#stack::value::Bytes::new(#s)),
+        Init::Real(x) => quote!(#ty::new(#x as _)),
+        Init::Int(v) | Init::NodeId(v) => {
+            let lit = literal(*v);
+            match e.data_type {
+                DataType::Boolean | DataType::Unsigned8 | DataType::Integer8 => lit,
+                t if t.bits().is_some_and(|b| ![16, 32, 64].contains(&b)) => {
+                    // 24-, 40-, 48- and 56-bit integers: their low bytes.
+                    let n = crate::dec(u64::from(t.bits().unwrap_or(0) / 8));
+                    quote!(#stack::value::low_bytes::<#n>(#lit as i64 as u64))
+                }
+                _ => quote!(#ty::new(#lit)),
+            }
+        }
+    }
+}
+
+/// An integer literal: hex from 10 up, like the datasheets.
 fn literal(v: i64) -> TokenStream {
     match v {
         10.. => crate::hex(v.unsigned_abs(), 1),
@@ -127,275 +161,204 @@ fn literal(v: i64) -> TokenStream {
     }
 }
 
-fn stored(e: &Entry) -> bool {
+/// One stored value of the image, in layout order: an entry, or an array's items alike.
+struct Leaf {
+    index: u16,
+    /// Its offset in `Values` and its bytes, as constant expressions.
+    offset: TokenStream,
+    size: TokenStream,
+    persistent: bool,
+}
+
+/// A default the value image cannot hold: the node-ID's, or a mode's.
+struct PatchOf {
+    index: u16,
+    offset: TokenStream,
+    width: u8,
+    value: Init,
+}
+
+/// What the struct walk gathers.
+#[derive(Default)]
+struct Layout {
+    /// Record structs, emitted once per shape.
+    structs: Vec<TokenStream>,
+    /// Record types emitted so far, by shape.
+    shapes: Vec<(String, Ident)>,
+    fields: Vec<TokenStream>,
+    /// The field initialisers of `DEFAULT_VALUES`.
+    defaults: Vec<TokenStream>,
+    leaves: Vec<Leaf>,
+    /// `(index, sub)` -> offset: what the entry tables carry.
+    offsets: BTreeMap<(u16, u8), TokenStream>,
+    node_ids: Vec<PatchOf>,
+    /// Per mode variant, the defaults that differ between modes.
+    per_mode: BTreeMap<String, Vec<PatchOf>>,
+    /// Generation errors (a default the patches cannot carry).
+    errors: Vec<String>,
+}
+
+impl Layout {
+    /// Notes the defaults of the entry at `offset` that the image cannot hold. Returns the
+    /// default the image holds (the first mode's).
+    fn defaults_of(&mut self, e: &Entry, index: u16, offset: &TokenStream, defaults: &[(Ident, Init)]) -> Init {
+        let first = defaults.first().map_or(Init::Int(0), |(_, v)| v.clone());
+        let varies = defaults.iter().any(|(_, v)| *v != first);
+        let width = e.data_type.bits().map_or(0, |b| b / 8);
+        let patch = |value: &Init| PatchOf { index, offset: offset.clone(), width: width as u8, value: value.clone() };
+        if varies || matches!(first, Init::NodeId(_)) {
+            let int = |v: &Init| matches!(v, Init::Int(_) | Init::NodeId(_));
+            if !(1..=4).contains(&width) || !defaults.iter().all(|(_, v)| int(v)) {
+                self.errors
+                    .push(format!("{index:04X}h sub {}: a default that depends on the mode or the node-ID must be an integer of at most 32 bits", e.sub));
+            }
+        }
+        if varies {
+            for (variant, v) in defaults {
+                self.per_mode.entry(variant.to_string()).or_default().push(patch(v));
+            }
+        } else if matches!(first, Init::NodeId(_)) {
+            self.node_ids.push(patch(&first));
+        }
+        first
+    }
+}
+
+fn is_stored(e: &Entry) -> bool {
     e.storage != Storage::App
 }
 
-/// Per index: field declarations, record structs, field names, dispatch arms and defaults.
-struct Parts {
-    structs: Vec<TokenStream>,
-    fields: Vec<TokenStream>,
-    /// The field names, for `Od::new`.
-    names: Vec<Ident>,
-    /// `(object number, sub) => &mut field` arms of `field`.
-    field_arms: Vec<TokenStream>,
-    /// The persistent block, saved by 1010h: its units in block (index) order.
-    persist: Vec<Unit>,
-    /// Record types that implement `Persistent` (emitted once per type).
-    persistent_records: Vec<Ident>,
-    /// Every stored entry (RAM and persistent): what an NMT reset sets back to its default.
-    resets: Vec<Place>,
-    /// Record types emitted so far, by shape (sub, field, type of each entry).
-    shapes: Vec<(String, Ident)>,
-}
-
-/// One stored value: its index, where it lives in `Od`, its type and its default.
-#[derive(Clone)]
-struct Place {
-    /// The object index, as a number and as the literal generated code uses.
-    number: u16,
-    index: TokenStream,
-    place: TokenStream,
-    ty: TokenStream,
-    /// The default: one expression, or a `match self.mode` where the modes differ.
-    default: TokenStream,
-    /// Whether the default differs between the modes the entry exists in.
-    per_mode: bool,
-}
-
-/// One unit of the persistent block: a field, an array's items, a whole array or a whole
-/// record, whose entries' images follow each other in the block.
-struct Unit {
-    /// The object index (every entry of a unit has the same).
-    index: TokenStream,
-    /// Where it lives in `Od`.
-    place: TokenStream,
-    /// Bytes of its image.
-    size: TokenStream,
-}
-
-/// The image size of one entry's field.
-fn image_size(ty: &TokenStream, stack: &TokenStream) -> TokenStream {
-    quote!(<#ty as #stack::value::Persist>::SIZE)
-}
-
-impl Place {
-    fn new(number: u16, place: TokenStream, ty: TokenStream, default: TokenStream, per_mode: bool) -> Place {
-        Place { number, index: crate::hex(number.into(), 4), place, ty, default, per_mode }
-    }
-}
-
-impl Parts {
-    /// A stored entry: reset by NMT resets, and a unit of the persistent block of its own
-    /// unless `grouped` (the caller saves it with others as one unit).
-    #[allow(clippy::too_many_arguments)]
-    fn place(&mut self, e: &Entry, number: u16, place: TokenStream, ty: TokenStream, defaults: ModeDefaults, grouped: bool, stack: &TokenStream) {
-        let distinct: std::collections::BTreeSet<String> = defaults.iter().map(|(_, t)| t.to_string()).collect();
-        let per_mode = distinct.len() > 1;
-        let default = match defaults.as_slice() {
-            [(_, only), ..] if !per_mode => only.clone(),
-            _ => {
-                // Modes the entry does not exist in keep the first mode's value: no table
-                // lists the entry there, so nothing reads it.
-                let arms = defaults.iter().map(|(v, t)| quote!(Mode::#v => #t));
-                quote!(match self.mode { #(#arms,)* #[allow(unreachable_patterns)] _ => Default::default() })
-            }
-        };
-        let p = Place::new(number, place, ty, default, per_mode);
-        if persistent(e) && !grouped {
-            self.persist.push(Unit { index: p.index.clone(), place: p.place.clone(), size: image_size(&p.ty, stack) });
-        }
-        self.resets.push(p);
-    }
-}
-
-fn persistent(e: &Entry) -> bool {
-    e.storage == Storage::Persistent
-}
-
-/// The defaults of one entry of the slot being generated, per mode.
-type DefaultsOf<'a> = &'a dyn Fn(u8) -> ModeDefaults;
-
-fn slot_parts(slot: &Slot<'_>, stack: &TokenStream, parts: &mut Parts, defaults: DefaultsOf<'_>) {
-    let number = crate::dec(slot.number.into());
+fn slot_layout(d: &Device, modes: &Modes, slot: &Slot<'_>, stack: &TokenStream, l: &mut Layout) {
     let o = slot.object;
-    // App-backed entries never reach `field`: the stack routes them by their storage class.
-    let kept: Vec<&Entry> = slot.entries.values().copied().filter(|e| stored(e)).collect();
-    if kept.is_empty() {
-        return;
-    }
+    let index = slot.index;
+    let kept: Vec<&Entry> = slot.entries.values().copied().filter(|e| is_stored(e)).collect();
+    let Some(&first) = kept.first() else { return };
     let field = id(&o.ident);
-    let doc = format!(" {:04X}h {}", slot.index, o.name);
-    match o.kind {
-        ObjectKind::Var | ObjectKind::Domain => plain_field(kept[0], &field, &doc, slot.index, &number, stack, parts, defaults),
-        ObjectKind::Array => {
-            let items: Vec<&Entry> = kept.iter().copied().filter(|e| e.sub > 0).collect();
+    let doc = format!(" {index:04X}h {}", o.name);
+    let defaults = |sub| mode_defaults(d, modes, index, sub);
+    let persistent = |e: &Entry| e.storage == Storage::Persistent;
+    let items: Vec<&Entry> = kept.iter().copied().filter(|e| e.sub > 0).collect();
+    match (o.kind, items.first()) {
+        (ObjectKind::Array, Some(&item)) => {
             let n = items.iter().map(|e| usize::from(e.sub)).max().unwrap_or(0);
-            let Some(first) = items.first() else {
-                // Only sub 0 is stored (the elements are app-backed): a plain field.
-                return plain_field(kept[0], &field, &doc, slot.index, &number, stack, parts, defaults);
-            };
-            let ty = rust_type(first, stack);
+            let ty = image_type(item, stack);
             let count = crate::dec(n as u64);
-            let sub0 = kept.iter().find(|e| e.sub == 0);
-            // Every item 1..=N persistent: the items are one unit, with sub 0 if it is
-            // persistent too (the same images at the same offsets as entry by entry).
-            let items_unit = items.len() == n && items.iter().all(|e| persistent(e));
-            let whole_unit = items_unit && sub0.is_some_and(|e| persistent(e));
-            if let Some(e) = sub0 {
-                parts.place(e, slot.index, quote!(self.#field.sub0), quote!(u8), defaults(e.sub), whole_unit, stack);
+            let mut init = quote!(0);
+            if let Some(e) = kept.iter().find(|e| e.sub == 0) {
+                let offset = quote!(::core::mem::offset_of!(Values, #field.sub0));
+                let v = l.defaults_of(e, index, &offset, &defaults(0));
+                init = constant(e, &quote!(u8), &v, stack);
+                l.leaves.push(Leaf { index, offset: offset.clone(), size: quote!(1), persistent: persistent(e) });
+                l.offsets.insert((index, 0), offset);
             }
-            if items_unit {
-                let index = crate::hex(slot.index.into(), 4);
-                let item_size = image_size(&ty, stack);
-                parts.persist.push(if whole_unit {
-                    Unit { index, place: quote!(self.#field), size: quote!(1 + #item_size * #count) }
-                } else {
-                    Unit { index, place: quote!(self.#field.items), size: quote!(#item_size * #count) }
-                });
-            }
-            let item_defaults: Vec<ModeDefaults> = items.iter().map(|e| defaults(e.sub)).collect();
-            let texts: std::collections::BTreeSet<String> = item_defaults.iter().flatten().map(|(_, t)| t.to_string()).collect();
-            match item_defaults.first().and_then(|d| d.first()) {
-                // Every item has one default in every mode: one array store resets them all
-                // (a fill, not one store per item); the store still saves item by item.
-                Some((_, default)) if texts.len() == 1 && items.len() == n => {
-                    for e in items.iter().filter(|e| persistent(e) && !items_unit) {
-                        let i = crate::dec(u64::from(e.sub) - 1);
-                        let index = crate::hex(slot.index.into(), 4);
-                        parts.persist.push(Unit { index, place: quote!(self.#field.items[#i]), size: image_size(&ty, stack) });
-                    }
-                    parts.resets.push(Place::new(slot.index, quote!(self.#field.items), quote!([#ty; #count]), quote!([#default; #count]), false));
+            let mut values = Vec::new();
+            for i in 1..=n {
+                let k = crate::dec((i - 1) as u64);
+                let offset = quote!(::core::mem::offset_of!(Values, #field.items) + #k * ::core::mem::size_of::<#ty>());
+                let Some(e) = items.iter().find(|e| usize::from(e.sub) == i) else {
+                    values.push(constant(item, &ty, &Init::Int(0), stack));
+                    continue;
+                };
+                if rust_type(e, stack).to_string() != rust_type(item, stack).to_string() {
+                    l.errors.push(format!("{index:04X}h sub {i}: an array's elements must have one data type"));
                 }
-                _ => {
-                    for (e, d) in items.iter().zip(item_defaults) {
-                        let i = crate::dec(u64::from(e.sub) - 1);
-                        parts.place(e, slot.index, quote!(self.#field.items[#i]), ty.clone(), d, items_unit, stack);
-                    }
+                let v = l.defaults_of(e, index, &offset, &defaults(e.sub));
+                values.push(constant(e, &ty, &v, stack));
+                l.offsets.insert((index, e.sub), offset);
+            }
+            // The items as one leaf when they persist alike (most arrays), else one each.
+            if items.iter().all(|e| persistent(e) == persistent(item)) {
+                let size = quote!(#count * ::core::mem::size_of::<#ty>());
+                l.leaves.push(Leaf { index, offset: quote!(::core::mem::offset_of!(Values, #field.items)), size, persistent: persistent(item) });
+            } else {
+                for e in &items {
+                    let offset = l.offsets.get(&(index, e.sub)).cloned().unwrap_or_default();
+                    l.leaves.push(Leaf { index, offset, size: quote!(::core::mem::size_of::<#ty>()), persistent: persistent(e) });
                 }
             }
-            parts.fields.push(quote!(#[doc = #doc] pub #field: #stack::value::Array<#ty, #count>));
-            parts.names.push(field.clone());
-            parts.field_arms.push(quote!((#number, s) => self.#field.sub(s)));
+            l.fields.push(quote!(#[doc = #doc] pub #field: #stack::value::Array<#ty, #count>));
+            l.defaults.push(quote!(#field: #stack::value::Array { sub0: #init, items: [#(#values),*] }));
         }
-        ObjectKind::Record => {
+        (ObjectKind::Record, _) => {
             let name = camel(&o.ident);
-            let mut sub_fields = Vec::new();
-            let mut sub_arms = Vec::new();
-            let mut shape = String::new();
-            // Every stored entry persistent: the record is one unit of the block.
-            let record_unit = kept.iter().all(|e| persistent(e));
-            let mut unit_fields = Vec::new();
-            let first_reset = parts.resets.len();
+            let (mut sub_fields, mut inits, mut shape) = (Vec::new(), Vec::new(), String::new());
             for e in &kept {
                 let f = id(&e.ident);
-                let sub = crate::dec(e.sub.into());
-                let ty = rust_type(e, stack);
-                parts.place(e, slot.index, quote!(self.#field.#f), ty.clone(), defaults(e.sub), record_unit, stack);
-                unit_fields.push((f.clone(), image_size(&ty, stack)));
+                let ty = image_type(e, stack);
+                let offset = quote!(::core::mem::offset_of!(Values, #field.#f));
+                let v = l.defaults_of(e, index, &offset, &defaults(e.sub));
+                let init = constant(e, &ty, &v, stack);
+                inits.push(quote!(#f: #init));
+                l.leaves.push(Leaf { index, offset: offset.clone(), size: quote!(::core::mem::size_of::<#ty>()), persistent: persistent(e) });
+                l.offsets.insert((index, e.sub), offset);
                 let sdoc = format!(" Sub {}: {}", e.sub, e.name);
                 shape.push_str(&format!("{}:{f}:{ty};", e.sub));
                 sub_fields.push(quote!(#[doc = #sdoc] pub #f: #ty));
-                sub_arms.push(quote!(#sub => &mut self.#f));
             }
-            // One store of a constant record (a copy from flash) resets the record, not one
-            // store per entry; defaults that depend on the mode or the node-ID (integers,
-            // 0 in the constant) are stored after it. Only for more than four constant
-            // entries: fewer are smaller as stores (measured on thumbv6m).
-            let record_resets = parts.resets.split_off(first_reset);
-            let varies = |p: &Place| p.per_mode || p.default.to_string().contains("node_id");
-            let integer = |p: &Place| ["u8", "u16", "u32", "u64", "i8", "i16", "i32", "i64"].contains(&p.ty.to_string().as_str());
-            if record_resets.iter().all(|p| !varies(p) || integer(p)) && record_resets.iter().filter(|p| !varies(p)).count() > 4 {
-                let names = kept.iter().map(|e| id(&e.ident));
-                let values = record_resets.iter().map(|p| if varies(p) { quote!(0) } else { p.default.clone() });
-                parts.resets.push(Place::new(
-                    slot.index,
-                    quote!(self.#field),
-                    quote!(#name),
-                    quote!({ const DEFAULT: #name = #name { #(#names: #values),* }; DEFAULT }),
-                    false,
-                ));
-                parts.resets.extend(record_resets.into_iter().filter(varies));
-            } else {
-                parts.resets.extend(record_resets);
-            }
-            // Records of one shape (the PDO parameter records) share one type and one
-            // sub-index dispatch; the later ones are aliases of the first.
-            let record_type = parts.shapes.iter().find(|(s, _)| *s == shape).map_or(name.clone(), |(_, first)| first.clone());
-            if record_unit {
-                let index = crate::hex(slot.index.into(), 4);
-                let sizes = unit_fields.iter().map(|(_, size)| size);
-                parts.persist.push(Unit { index, place: quote!(self.#field), size: quote!(0 #(+ #sizes)*) });
-                if !parts.persistent_records.contains(&record_type) {
-                    parts.persistent_records.push(record_type.clone());
-                    let (names, sizes): (Vec<&Ident>, Vec<&TokenStream>) = unit_fields.iter().map(|(f, size)| (f, size)).unzip();
-                    parts.structs.push(quote! {
-                        /// The record's entries, one after the other in the persistent block.
-                        impl #stack::value::Persistent for #record_type {
-                            fn save_to(&self, at: usize, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-                                #stack::value::save_fields(&[#((&self.#names, #sizes)),*], at, sink)
-                            }
-                            fn load_from(&mut self, at: usize, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-                                #stack::value::load_fields(&mut [#((&mut self.#names, #sizes)),*], at, source)
-                            }
-                        }
-                    });
-                }
-            }
-            match parts.shapes.iter().find(|(s, _)| *s == shape) {
+            // Records of one shape (the PDO parameter records) share one type; the later ones
+            // are aliases of the first.
+            let record_type = match l.shapes.iter().find(|(s, _)| *s == shape) {
                 Some((_, first)) => {
                     let alias = format!("{doc} (the same record as [`{first}`])");
-                    parts.structs.push(quote!(#[doc = #alias] pub type #name = #first;));
+                    l.structs.push(quote!(#[doc = #alias] pub type #name = #first;));
+                    first.clone()
                 }
                 None => {
-                    parts.shapes.push((shape, name.clone()));
-                    parts.structs.push(quote! {
+                    l.shapes.push((shape, name.clone()));
+                    let zerocopy = zerocopy_path(stack);
+                    let zerocopy_crate = zerocopy_crate(stack);
+                    l.structs.push(quote! {
                         #[doc = #doc]
-                        #[derive(Debug, Clone, PartialEq, Default)]
+                        #[derive(Debug, Clone, Copy, PartialEq, #zerocopy::FromBytes, #zerocopy::IntoBytes, #zerocopy::KnownLayout, #zerocopy::Immutable, #zerocopy::Unaligned)]
+                        #[zerocopy(crate = #zerocopy_crate)]
+                        #[repr(C)]
                         pub struct #name { #(#sub_fields),* }
-
-                        impl #name {
-                            /// The field of sub-index `sub`.
-                            #[inline]
-                            pub fn sub(&mut self, sub: u8) -> Option<&mut dyn #stack::value::OdValue> {
-                                Some(match sub {
-                                    #(#sub_arms,)*
-                                    _ => return None,
-                                })
-                            }
-                        }
                     });
+                    name.clone()
                 }
-            }
-            parts.field_arms.push(quote!((#number, s) => self.#field.sub(s)));
-            parts.fields.push(quote!(#[doc = #doc] pub #field: #name));
-            parts.names.push(field.clone());
+            };
+            l.fields.push(quote!(#[doc = #doc] pub #field: #name));
+            l.defaults.push(quote!(#field: #record_type { #(#inits),* }));
+        }
+        // A VAR, a DOMAIN, or an array or record whose only stored entry is sub 0.
+        _ => {
+            let ty = image_type(first, stack);
+            let offset = quote!(::core::mem::offset_of!(Values, #field));
+            let v = l.defaults_of(first, index, &offset, &defaults(first.sub));
+            l.leaves.push(Leaf { index, offset: offset.clone(), size: quote!(::core::mem::size_of::<#ty>()), persistent: persistent(first) });
+            l.offsets.insert((index, first.sub), offset);
+            l.fields.push(quote!(#[doc = #doc] pub #field: #ty));
+            let init = constant(first, &ty, &v, stack);
+            l.defaults.push(quote!(#field: #init));
         }
     }
 }
 
-/// A single stored entry (a VAR, or sub 0 alone) as one field.
-#[allow(clippy::too_many_arguments)]
-fn plain_field(
-    e: &Entry,
-    field: &Ident,
-    doc: &str,
-    index: u16,
-    number: &proc_macro2::Literal,
-    stack: &TokenStream,
-    parts: &mut Parts,
-    defaults: DefaultsOf<'_>,
-) {
-    let ty = rust_type(e, stack);
-    parts.place(e, index, quote!(self.#field), ty.clone(), defaults(e.sub), false, stack);
-    parts.fields.push(quote!(#[doc = #doc] pub #field: #ty));
-    parts.names.push(field.clone());
-    // The caller has found `sub` in this entry's run, so a single field needs no sub test.
-    parts.field_arms.push(quote!((#number, _) => Some(&mut self.#field)));
+fn zerocopy_path(stack: &TokenStream) -> TokenStream {
+    quote!(#stack::zerocopy)
 }
 
-/// The class of an index: resets test one index per run of places in the same class, since
-/// every [`Area`](https://docs.rs/coforge-stack) is a union of whole classes.
+/// The path the zerocopy derives name their crate by, as the string their attribute takes.
+fn zerocopy_crate(stack: &TokenStream) -> String {
+    format!("{stack}::zerocopy").replace(' ', "")
+}
+
+fn layout(d: &Device, modes: &Modes, stack: &TokenStream) -> Layout {
+    let mut l = Layout::default();
+    for slot in slots(d) {
+        slot_layout(d, modes, &slot, stack, &mut l);
+    }
+    l
+}
+
+/// `(index, sub)` -> the offset in the value image of every stored entry: the entry tables'
+/// `offset`.
+pub(crate) fn offsets(d: &Device, stack: &TokenStream) -> BTreeMap<(u16, u8), TokenStream> {
+    layout(d, &Modes::of(d), stack).offsets
+}
+
+/// The class of an index: a span never holds two, since every `Area` is a union of whole
+/// classes.
 fn area_class(index: u16) -> u8 {
     match index {
         0x0000..=0x0FFF => 0,
@@ -406,23 +369,42 @@ fn area_class(index: u16) -> u8 {
     }
 }
 
-/// `reset_area`'s body: one `if` per run of places in the same index class.
-fn reset_groups(resets: &[Place]) -> Vec<TokenStream> {
-    let mut groups: Vec<(u16, Vec<&Place>)> = Vec::new();
-    for p in resets {
+/// Consecutive leaves that `take` selects, of one index class, as one span each (the leaves
+/// are in layout order, so consecutive ones are adjacent bytes).
+fn spans(leaves: &[Leaf], take: impl Fn(&Leaf) -> bool, stack: &TokenStream) -> Vec<TokenStream> {
+    let mut groups: Vec<Vec<&Leaf>> = Vec::new();
+    let mut open = false;
+    for leaf in leaves {
         match groups.last_mut() {
-            Some((first, places)) if area_class(*first) == area_class(p.number) => places.push(p),
-            _ => groups.push((p.number, vec![p])),
+            Some(g) if open && take(leaf) && g.first().is_some_and(|f| area_class(f.index) == area_class(leaf.index)) => g.push(leaf),
+            _ if take(leaf) => groups.push(vec![leaf]),
+            _ => {}
         }
+        open = take(leaf);
     }
     groups
-        .into_iter()
-        .map(|(_, places)| {
-            let index = &places[0].index;
-            let (targets, defaults): (Vec<&TokenStream>, Vec<&TokenStream>) = places.iter().map(|p| (&p.place, &p.default)).unzip();
-            quote!(if area.contains(#index) { #(#targets = #defaults;)* })
+        .iter()
+        .filter_map(|g| {
+            let (first, last) = (g.first()?, g.last()?);
+            let index = crate::hex(first.index.into(), 4);
+            let (start, end) = (&first.offset, &last.offset);
+            let size = &last.size;
+            Some(quote!(#stack::od::image::Span { index: #index, start: (#start) as u16, len: (#end + #size - (#start)) as u16 }))
         })
         .collect()
+}
+
+fn patch_tokens(p: &PatchOf, stack: &TokenStream) -> TokenStream {
+    let index = crate::hex(p.index.into(), 4);
+    let offset = &p.offset;
+    let width = crate::dec(p.width.into());
+    let (plus_node_id, value) = match p.value {
+        Init::NodeId(v) => (true, v),
+        Init::Int(v) => (false, v),
+        _ => (false, 0),
+    };
+    let value = crate::hex(value as u32 as u64, 1);
+    quote!(#stack::od::image::Patch { index: #index, at: (#offset) as u16, width: #width, plus_node_id: #plus_node_id, value: #value })
 }
 
 pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
@@ -430,52 +412,87 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let block_transfer = d.identity.sdo_block_transfer;
     let has = |index: u16| d.objects.iter().any(|o| o.index == index);
     let (history, sync_cycle, consumer) = (has(0x1003), has(0x1006), has(0x1016));
-    let mut parts = Parts {
-        structs: Vec::new(),
-        fields: Vec::new(),
-        names: Vec::new(),
-        field_arms: Vec::new(),
-        persist: Vec::new(),
-        persistent_records: Vec::new(),
-        resets: Vec::new(),
-        shapes: Vec::new(),
-    };
-    for slot in slots(d) {
-        let defaults = |sub| mode_defaults(d, modes, slot.index, sub, stack);
-        slot_parts(&slot, stack, &mut parts, &defaults);
-    }
-    let Parts { structs, fields, names, field_arms, persist, resets, .. } = parts;
-    let p_index: Vec<&TokenStream> = persist.iter().map(|u| &u.index).collect();
-    let places: Vec<&TokenStream> = persist.iter().map(|u| &u.place).collect();
-    let sizes: Vec<&TokenStream> = persist.iter().map(|u| &u.size).collect();
-    let unit_numbers: Vec<proc_macro2::Literal> = (0..persist.len()).map(|n| crate::dec(n as u64)).collect();
-    let unit_count = crate::dec(persist.len() as u64);
-    // The entries whose default differs between modes are reset by one function, which
-    // `set_mode` calls too.
-    let (mode_resets, resets): (Vec<Place>, Vec<Place>) = resets.into_iter().partition(|p| p.per_mode);
-    let mode_groups = reset_groups(&mode_resets);
-    let reset_groups = reset_groups(&resets);
+    let l = layout(d, modes, stack);
+    let errors = l.errors.iter().map(|e| quote!(::core::compile_error!(#e);));
+    let stored = spans(&l.leaves, |_| true, stack);
+    let persistent = spans(&l.leaves, |leaf| leaf.persistent, stack);
+    let (stored_n, persistent_n) = (crate::dec(stored.len() as u64), crate::dec(persistent.len() as u64));
+    let node_ids: Vec<TokenStream> = l.node_ids.iter().map(|p| patch_tokens(p, stack)).collect();
+    let node_id_n = crate::dec(node_ids.len() as u64);
+    let per_mode: Vec<Vec<TokenStream>> = modes
+        .variants
+        .iter()
+        .map(|(v, _)| l.per_mode.get(&v.to_string()).map_or(Vec::new(), |ps| ps.iter().map(|p| patch_tokens(p, stack)).collect()))
+        .collect();
+    let (mode_tables, mode_select) = modes.tables("MODE_DEFAULTS", &quote!(#stack::od::image::Patch), &per_mode);
+    let Layout { structs, fields, defaults, .. } = l;
+    let zerocopy = zerocopy_path(stack);
+    let zerocopy_crate = zerocopy_crate(stack);
     let node_config = node_config(d, stack);
     quote! {
+        #(#errors)*
         #(#structs)*
 
-        /// The device's object dictionary: typed fields for what lives in RAM, `app` for
-        /// what the device keeps elsewhere.
+        /// The values of every RAM and persistent entry, in index order: typed fields for the
+        /// device's code, and, byte for byte, the value image the entry table's offsets point
+        /// into (`coforge_stack::od::image`).
+        // `Copy`: a copy of the defaults is one copy of their image, not one per field.
+        #[derive(Debug, Clone, Copy, #zerocopy::FromBytes, #zerocopy::IntoBytes, #zerocopy::KnownLayout, #zerocopy::Immutable, #zerocopy::Unaligned)]
+        #[zerocopy(crate = #zerocopy_crate)]
+        #[repr(C)]
+        pub struct Values {
+            #(#fields),*
+        }
+
+        /// The spec's defaults (the first mode's where the modes differ; `$NODEID` ones
+        /// without the node-ID, which `NODE_ID_DEFAULTS` adds).
+        pub static DEFAULT_VALUES: Values = Values { #(#defaults),* };
+
+        /// The spans NMT resets set back to the defaults.
+        static STORED: [#stack::od::image::Span; #stored_n] = [#(#stored),*];
+
+        /// The persistent block 1010h saves: the persistent spans one after the other.
+        static PERSISTENT: [#stack::od::image::Span; #persistent_n] = [#(#persistent),*];
+
+        /// The defaults `$NODEID + n` of every mode.
+        static NODE_ID_DEFAULTS: [#stack::od::image::Patch; #node_id_n] = [#(#node_ids),*];
+
+        #(#mode_tables)*
+
+        /// The defaults of `mode` that differ between the modes.
+        fn mode_defaults(mode: Mode) -> &'static [#stack::od::image::Patch] {
+            #mode_select
+        }
+
+        /// The device's object dictionary: the values of what lives in RAM (`values`, also
+        /// reached through `Deref`), `app` for what the device keeps elsewhere.
         #[derive(Debug, Clone)]
         pub struct Od<A> {
             mode: Mode,
             /// Reads and writes of app-backed objects go here.
             pub app: A,
-            #(#fields),*
+            pub values: Values,
+        }
+
+        impl<A> ::core::ops::Deref for Od<A> {
+            type Target = Values;
+            fn deref(&self) -> &Values {
+                &self.values
+            }
+        }
+
+        impl<A> ::core::ops::DerefMut for Od<A> {
+            fn deref_mut(&mut self) -> &mut Values {
+                &mut self.values
+            }
         }
 
         impl<A: #stack::od::AppObjects> Od<A> {
             /// The dictionary with the spec's defaults of `mode`, `$NODEID` resolved for
-            /// `node_id`: all zero first, then the one place that knows the defaults,
-            /// `reset_area`.
+            /// `node_id`.
             pub fn new(mode: Mode, node_id: u8, app: A) -> Self {
                 use #stack::od::NodeDictionary as _;
-                let mut od = Od { mode, app, #(#names: Default::default()),* };
+                let mut od = Od { mode, app, values: DEFAULT_VALUES };
                 od.reset_area(#stack::od::Area::ALL, node_id);
                 od
             }
@@ -483,37 +500,7 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             pub fn mode(&self) -> Mode {
                 self.mode
             }
-
-            /// The defaults that differ between modes, in `area`: what `set_mode` sets (in
-            /// every area) and `reset_area` (after the others).
-            #[allow(unused_variables)]
-            fn reset_mode_defaults(&mut self, area: #stack::od::Area, node_id: u8) {
-                #(#mode_groups)*
-            }
-
-            /// Unit `n` of the persistent block ([`PERSISTENT_UNITS`]).
-            #[allow(unreachable_code)]
-            fn persistent_unit(&self, n: usize) -> Option<&dyn #stack::value::Persistent> {
-                Some(match n {
-                    #(#unit_numbers => &#places,)*
-                    _ => return None,
-                })
-            }
-
-            /// Unit `n` of the persistent block, to load it.
-            #[allow(unreachable_code)]
-            fn persistent_unit_mut(&mut self, n: usize) -> Option<&mut dyn #stack::value::Persistent> {
-                Some(match n {
-                    #(#unit_numbers => &mut #places,)*
-                    _ => return None,
-                })
-            }
         }
-
-        /// The units of the persistent block (every `storage: persistent` entry, index order):
-        /// each one's index and image size. The store code walks this table once for every
-        /// unit instead of a copy of it per entry.
-        const PERSISTENT_UNITS: [(u16, u16); #unit_count] = [#((#p_index, (#sizes) as u16)),*];
 
         /// The node settings of the spec's `node:` section, for `node_id`.
         pub const fn node_config(node_id: u8) -> #stack::config::NodeConfig {
@@ -523,37 +510,19 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
         impl<A: #stack::od::AppObjects> #stack::od::NodeDictionary for Od<A> {
             type Mode = Mode;
             const MODES: &'static [Mode] = &Mode::ALL;
-            const PERSISTENT_SIZE: usize = 0 #(+ #sizes)*;
+            const PERSISTENT: &'static [#stack::od::image::Span] = &PERSISTENT;
+            const STORED: &'static [#stack::od::image::Span] = &STORED;
+            const NODE_ID_DEFAULTS: &'static [#stack::od::image::Patch] = &NODE_ID_DEFAULTS;
             const SDO_BLOCK_TRANSFER: bool = #block_transfer;
             const COMM: #stack::od::CommObjects =
                 #stack::od::CommObjects { error_history: #history, sync_cycle: #sync_cycle, heartbeat_consumer: #consumer };
 
-            fn save_area(&self, area: #stack::od::Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-                let (mut at, mut ok) = (0, true);
-                for (n, &(index, size)) in PERSISTENT_UNITS.iter().enumerate() {
-                    if area.contains(index) {
-                        ok &= self.persistent_unit(n).is_some_and(|unit| unit.save_to(at, sink));
-                    }
-                    at += usize::from(size);
-                }
-                ok
+            fn defaults() -> &'static [u8] {
+                #zerocopy::IntoBytes::as_bytes(&DEFAULT_VALUES)
             }
 
-            fn load_area(&mut self, area: #stack::od::Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-                let (mut at, mut ok) = (0, true);
-                for (n, &(index, size)) in PERSISTENT_UNITS.iter().enumerate() {
-                    if area.contains(index) {
-                        ok &= self.persistent_unit_mut(n).is_some_and(|unit| unit.load_from(at, source));
-                    }
-                    at += usize::from(size);
-                }
-                ok
-            }
-
-            #[allow(unused_variables)]
-            fn reset_area(&mut self, area: #stack::od::Area, node_id: u8) {
-                #(#reset_groups)*
-                self.reset_mode_defaults(area, node_id);
+            fn mode_defaults(&self) -> &'static [#stack::od::image::Patch] {
+                mode_defaults(self.mode)
             }
 
             fn emergencies(&self) -> &'static [#stack::emcy::EmcyDefault] {
@@ -572,10 +541,9 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
                 self.mode
             }
 
-            #[allow(unused_variables)]
             fn set_mode(&mut self, mode: Mode, node_id: u8) {
                 self.mode = mode;
-                self.reset_mode_defaults(#stack::od::Area::ALL, node_id);
+                #stack::od::image::patch(#zerocopy::IntoBytes::as_mut_bytes(&mut self.values), mode_defaults(mode), #stack::od::Area::ALL, node_id);
             }
 
             fn mode_name(mode: Mode) -> &'static str {
@@ -598,12 +566,12 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
                 &od::LIMITS
             }
 
-            #[allow(unreachable_patterns)]
-            fn field(&mut self, info: &#stack::od::EntryInfo, sub: u8) -> Option<&mut dyn #stack::value::OdValue> {
-                match (info.object, sub) {
-                    #(#field_arms,)*
-                    _ => None,
-                }
+            fn image(&self) -> &[u8] {
+                #zerocopy::IntoBytes::as_bytes(&self.values)
+            }
+
+            fn image_mut(&mut self) -> &mut [u8] {
+                #zerocopy::IntoBytes::as_mut_bytes(&mut self.values)
             }
 
             fn app(&mut self) -> &mut A {

@@ -13,10 +13,6 @@ use quote::{format_ident, quote};
 /// more to reach "too long", and strings cut short.
 pub const DATA: usize = 5;
 
-/// String bytes of the write harnesses' `TypedCells`: at least [`DATA`], and what the test
-/// that the generated fields answer as the cells do compares.
-const CELL_STRING: usize = 16;
-
 /// The value buffer of `coforge_stack::od::properties` (`BUF`): the longest loop of a constant
 /// length the harnesses reach.
 const READ_BUF: usize = 16;
@@ -41,17 +37,16 @@ pub fn proofs_module(device: &Device, modes: &Modes, options: &Options) -> Token
         let write = format_ident!("write_keeps_the_rules_{}", name);
         let read = format_ident!("read_keeps_the_rules_{}", name);
         let n = dec(DATA as u64);
-        let cells = dec(CELL_STRING as u64);
         quote! {
             /// Any write keeps the dictionary's rules (`prop_write_is_checked`), on this
-            /// mode's table with `TypedCells` in place of the generated fields; that the
-            /// fields answer as the cells do is `tests/dictionary_properties.rs`.
+            /// mode's table over a value image of any bytes (`ImageCells`: the device's
+            /// app-backed objects left out).
             #[kani::proof]
             #[kani::unwind(#unwind)]
             #[kani::solver(kissat)]
             fn #write() {
                 let od = super::Od::new(super::Mode::#variant, 1, #stack::od::NoAppObjects);
-                let mut cells = #stack::od::properties::TypedCells::<#cells>::over(&od, kani::any(), kani::any_where(|n: &usize| *n <= 8));
+                let mut cells = #stack::od::properties::ImageCells::<{ ::core::mem::size_of::<super::Values>() }>::over(&od, kani::any());
                 let data: [u8; #n] = kani::any();
                 let len: usize = kani::any_where(|l: &usize| *l <= #n);
                 let ctx = #stack::od::AccessContext { nmt: any_state(), can_enabled: kani::any() };

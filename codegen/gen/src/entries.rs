@@ -118,10 +118,9 @@ fn ident(name: &str) -> Ident {
     Ident::new(name, Span::call_site())
 }
 
-fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<LimitsKey>) -> TokenStream {
+fn run_tokens(r: &Run, offset: TokenStream, stack: &TokenStream, limits: &mut Vec<LimitsKey>) -> TokenStream {
     let Run { index, sub, last_sub, copies, meta: m } = r;
     let copies = crate::dec((*copies).into());
-    let object = crate::dec(object.into());
     let index = crate::hex((*index).into(), 4);
     let (sub, last_sub) = (crate::dec((*sub).into()), crate::dec((*last_sub).into()));
     let data_type = ident(&format!("{:?}", m.data_type));
@@ -159,7 +158,7 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
     quote! {
         #stack::od::EntryInfo {
             index: #index,
-            object: #object,
+            offset: (#offset) as u16,
             size: #size,
             sub: #sub,
             last_sub: #last_sub,
@@ -173,14 +172,11 @@ fn run_tokens(r: &Run, object: u16, stack: &TokenStream, limits: &mut Vec<Limits
 pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let stack = &options.stack;
     let mut limits: Vec<LimitsKey> = Vec::new();
-    let numbers = crate::dictionary::object_numbers(d);
-    let per_mode: Vec<Vec<TokenStream>> = modes
-        .variants
-        .iter()
-        .map(|(_, mode)| {
-            runs(d, mode.as_deref()).iter().map(|r| run_tokens(r, numbers.get(&r.index).copied().unwrap_or_default(), stack, &mut limits)).collect()
-        })
-        .collect();
+    let offsets = crate::dictionary::offsets(d, stack);
+    // App-backed runs have no place in the value image: offset 0, never read.
+    let offset = |r: &Run| offsets.get(&(r.index, r.sub)).cloned().filter(|_| r.meta.storage != "App").unwrap_or_else(|| quote!(0));
+    let per_mode: Vec<Vec<TokenStream>> =
+        modes.variants.iter().map(|(_, mode)| runs(d, mode.as_deref()).iter().map(|r| run_tokens(r, offset(r), stack, &mut limits)).collect()).collect();
     let (tables, select) = modes.tables("ENTRIES", &quote!(#stack::od::EntryInfo), &per_mode);
     let limit_items: Vec<TokenStream> = limits
         .iter()
@@ -207,6 +203,9 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
         /// Object dictionary metadata, generated from the spec.
         pub mod od {
             use super::Mode;
+            // The entries' offsets are places in it.
+            #[allow(unused_imports)]
+            use super::Values;
             /// Bytes of the largest value the bus may write (the SDO download buffer).
             pub const MAX_WRITE_SIZE: usize = #max_write;
             /// Every distinct value limit of the dictionary: an entry's `limits` n is entry n - 1.

@@ -234,6 +234,20 @@ mod tests {
     }
 }
 
+/// The low `N` bytes of `value`, little-endian: the image of a 24-, 40-, 48- or 56-bit
+/// integer's default.
+#[allow(clippy::indexing_slicing)] // `i < N <= 8`: `get` is not usable in const here.
+pub const fn low_bytes<const N: usize>(value: u64) -> [u8; N] {
+    let le = value.to_le_bytes();
+    let mut out = [0; N];
+    let mut i = 0;
+    while i < N && i < 8 {
+        out[i] = le[i];
+        i += 1;
+    }
+    out
+}
+
 /// An ARRAY object's storage: sub 0 and the elements 1..=N (byte-aligned types: no padding
 /// between them, as the value image has it).
 #[derive(Debug, Clone, Copy, PartialEq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
@@ -249,4 +263,3 @@ impl<T: Default + Copy, const N: usize> Default for Array<T, N> {
         Array { sub0: 0, items: [T::default(); N] }
     }
 }
-

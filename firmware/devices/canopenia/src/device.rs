@@ -290,7 +290,7 @@ impl<S: ParamStore, M: ConfigMemory> Canopenia<S, M> {
     }
 
     fn manager_control(&self) -> u32 {
-        self.node.od().device_control.manager_control
+        self.node.od().device_control.manager_control.get()
     }
 
     /// Room an answer owed to a running S or U keeps in the output queue.
@@ -392,8 +392,8 @@ impl<S: ParamStore, M: ConfigMemory> Canopenia<S, M> {
         let c = &self.node.od().device_control;
         rpdo_transmit::Times {
             update_ms: c.default_pdo_update_time,
-            event_ms: c.default_pdo_transmission_event_time,
-            inhibit_100us: c.default_pdo_transmission_inhibit_time,
+            event_ms: c.default_pdo_transmission_event_time.get(),
+            inhibit_100us: c.default_pdo_transmission_inhibit_time.get(),
         }
     }
 
@@ -484,8 +484,8 @@ impl<S: ParamStore, M: ConfigMemory> Canopenia<S, M> {
     /// node's monitoring.
     fn apply_manager_control(&mut self) {
         let control = &self.node.od().device_control;
-        let times = if control.manager_control & HB_RECEIVE_ALL != 0 {
-            (control.default_heartbeat_producer_time, control.default_heartbeat_consumer_time)
+        let times = if control.manager_control.get() & HB_RECEIVE_ALL != 0 {
+            (control.default_heartbeat_producer_time.get(), control.default_heartbeat_consumer_time.get())
         } else {
             (0, 0)
         };

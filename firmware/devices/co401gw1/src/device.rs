@@ -24,6 +24,7 @@ use coforge_stack::od::{EntryAccess, NodeDictionary, Side};
 use coforge_stack::pdo::Dir;
 use coforge_stack::store::{BlockStore, ParamStore};
 use coforge_stack::time::{div_rem_u64, ms_of_us};
+use coforge_stack::zerocopy::little_endian::I32;
 use heapless::Deque;
 
 /// Bytes waiting for the host: two of the longest telegrams (an emergency report is 10 bytes,
@@ -196,7 +197,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
     /// size, CFG0's default for the hardware inputs; then the host's configuration again.
     fn after_reset(&mut self) {
         let od = self.node.od_mut();
-        od.system_configuration = self.pins.system_configuration;
+        od.system_configuration.set(self.pins.system_configuration);
         if let Some(id) = self.pins.node_id {
             od.node_id = id;
         }
@@ -286,7 +287,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         }
         self.emergency_inputs = active;
         let od = self.node.od_mut();
-        od.status_register = u32::from(active & 1) | u32::from(active & 2) << 3;
+        od.status_register.set(u32::from(active & 1) | u32::from(active & 2) << 3);
         for (bit, e) in [(1, &emcy::APPLICATION_EMERGENCY_0), (2, &emcy::APPLICATION_EMERGENCY_1)] {
             match (active & bit != 0, self.node.is_active(e)) {
                 (true, false) => self.node.raise(e),
@@ -310,7 +311,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
             let (modes, values) = (od.error_mode_analog_output.items, od.error_value_analog_output.items);
             for ((out, mode), value) in od.write_analog_output.items.iter_mut().zip(modes).zip(values) {
                 if mode != 0 {
-                    *out = ds401::analog_error_value(value);
+                    out.set(ds401::analog_error_value(value.get()));
                 }
             }
         }
@@ -326,7 +327,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         let bytes = u32::from(od.app.bytes());
         let in_use = u128::MAX.checked_shr(128 - 8 * bytes.min(16)).unwrap_or(0);
         let digital_same = (u128::from_le_bytes(self.inputs_seen) ^ u128::from_le_bytes(od.app.inputs)) & in_use == 0;
-        let analog_same = od.mode() != Mode::Mixed || od.read_analog_input.items == self.analog_seen;
+        let analog_same = od.mode() != Mode::Mixed || od.read_analog_input.items.map(|v| v.get()) == self.analog_seen;
         if digital_same && analog_same {
             return;
         }
@@ -337,7 +338,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         };
         let mut digital = 0_u16;
         for (i, (seen, &now)) in self.inputs_seen.iter_mut().zip(&od.app.inputs).enumerate().take(usize::from(od.app.bytes())) {
-            if ds401::digital_event(od.global_interrupt_enable, masks(i), *seen, now) {
+            if ds401::digital_event(od.global_interrupt_enable != 0, masks(i), *seen, now) {
                 digital |= 1 << i;
             }
             *seen = now;
@@ -345,8 +346,8 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         let mut analog = 0_u8;
         if od.mode() == Mode::Mixed {
             for ch in 0..CHANNELS {
-                let now = od.read_analog_input.items.get(ch).copied().unwrap_or(0);
-                let get = |a: &[i32]| a.get(ch).copied().unwrap_or(0);
+                let now = od.read_analog_input.items.get(ch).map_or(0, |v| v.get());
+                let get = |a: &[I32]| a.get(ch).map_or(0, |v| v.get());
                 let trigger = AnalogTrigger {
                     conditions: od.analog_input_interrupt_trigger.items.get(ch).copied().unwrap_or(0),
                     upper_limit: get(&od.analog_input_upper_limit.items),
@@ -356,7 +357,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
                     positive_delta: get(&od.analog_input_positive_delta.items),
                 };
                 let (Some(seen), Some(sent)) = (self.analog_seen.get_mut(ch), self.analog_sent.get_mut(ch)) else { continue };
-                if ds401::analog_event(od.analog_input_interrupt_enable, trigger, *sent, *seen, now) {
+                if ds401::analog_event(od.analog_input_interrupt_enable != 0, trigger, *sent, *seen, now) {
                     analog |= 1 << ch;
                     *sent = now;
                 }

@@ -115,7 +115,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
         self.supply = self.supply.next(mv);
         let od = self.node.od_mut();
         od.app.set_writes_allowed(self.supply.writes_allowed());
-        od.supply_voltage_monitor = mv;
+        od.supply_voltage_monitor.set(mv);
     }
 
     /// Brings everything derived from the banks, the supply state last sampled and the monitor
@@ -125,7 +125,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
     /// moment) and updates after.
     fn update(&mut self, force: bool) {
         let od = self.node.od_mut();
-        od.system_configuration = self.config.system_configuration;
+        od.system_configuration.set(self.config.system_configuration);
         let status = [od.app.status(0), od.app.status(1)];
         let [bank1, bank2] = status;
         let active = [bank1.is_error(), bank2.is_error(), self.supply >= Supply::Low, self.supply >= Supply::Critical];
@@ -171,7 +171,7 @@ impl<S: Storage, B: Board> Device for Memory1<S, B> {
     fn on_frame(&mut self, frame: &CanFrame, now_us: u64) {
         // The frame may write the memory: the guard must know the supply of this moment.
         self.sample_supply();
-        let monitored = monitored_id(self.node.od().rpdo2_comm.cob_id_used_by_rpdo);
+        let monitored = monitored_id(self.node.od().rpdo2_comm.cob_id_used_by_rpdo.get());
         if monitored == Some(frame.id) && !frame.rtr {
             self.monitor.capture(frame.payload());
             let od = self.node.od_mut();

@@ -90,7 +90,7 @@ impl<S: Storage, B: Board> Memory1<S, B> {
         if id > 0x7FF || self.consumed_by_stack(id) {
             return false;
         }
-        let current = self.node.od().rpdo2_comm.cob_id_used_by_rpdo;
+        let current = self.node.od().rpdo2_comm.cob_id_used_by_rpdo.get();
         // CiA 301: a valid COB-ID is invalidated before it changes.
         let invalid = current | 0x8000_0000;
         if self.node.write(index::RPDO2_COMM, 1, &invalid.to_le_bytes(), Side::Device).is_err() {
@@ -104,8 +104,8 @@ impl<S: Storage, B: Board> Memory1<S, B> {
     fn consumed_by_stack(&self, id: u16) -> bool {
         let od = self.node.od();
         let node = u16::from(self.node.node_id());
-        let sync = (od.cob_id_sync & 0x7FF) as u16;
-        let rpdo1 = monitored_id(od.rpdo1_comm.cob_id_used_by_rpdo);
+        let sync = (od.cob_id_sync.get() & 0x7FF) as u16;
+        let rpdo1 = monitored_id(od.rpdo1_comm.cob_id_used_by_rpdo.get());
         id != 0 && (id == sync || id == 0x600 + node || id == 0x700 + node || Some(id) == rpdo1)
     }
 

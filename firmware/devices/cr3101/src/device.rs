@@ -253,9 +253,9 @@ impl<B: Board, S: ParamStore> Cr3101<B, S> {
         let CardStatus { inserted, write_protected, capacity, unusable } = status;
         od.status_of_the_memory_card.memory_card_inserted = inserted.into();
         od.status_of_the_memory_card.write_protect_status = write_protected.into();
-        od.status_of_the_memory_card.capacity_of_the_memory_card = capacity;
+        od.status_of_the_memory_card.capacity_of_the_memory_card.set(capacity);
         // 1002h: bit 0 card inserted, bit 1 NOT write protected, bit 2 battery good (CR-10).
-        od.state_register = u32::from(inserted) | u32::from(inserted && !write_protected) << 1 | u32::from(battery_ok) << 2;
+        od.state_register.set(u32::from(inserted) | u32::from(inserted && !write_protected) << 1 | u32::from(battery_ok) << 2);
 
         self.mirror(&emcy::LOW_BATTERY, !battery_ok);
         if conditions.no_card_access {

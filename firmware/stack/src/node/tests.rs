@@ -6,11 +6,11 @@
 use super::{BusState, Node, NodeConfig, NodeEvent};
 use crate::emcy::{EmcyDefault, EmcyEvent, Reaction};
 use crate::frame::CanFrame;
+use crate::od::image::{Patch, Span};
 use crate::od::{
     Access, AppObjects, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NodeDictionary, ReadLen, SdoAbort,
     Side, Storage, WriteSource, read_slice,
 };
-use crate::od::image::{Patch, Span};
 use crate::store::NoStore;
 use coforge_types::NmtState;
 extern crate std;
@@ -227,10 +227,13 @@ impl NodeDictionary for TestOd {
     const MODES: &'static [()] = &[()];
     const PERSISTENT: &'static [Span] = &[];
     const STORED: &'static [Span] = &SPANS;
-    const DEFAULTS: &'static [u8] = &DEFAULTS;
     const NODE_ID_DEFAULTS: &'static [Patch] = &NODE_ID_DEFAULTS;
     const SDO_BLOCK_TRANSFER: bool = false;
     const COMM: CommObjects = CommObjects { error_history: false, sync_cycle: false, heartbeat_consumer: true };
+
+    fn defaults() -> &'static [u8] {
+        &DEFAULTS
+    }
 
     fn mode_defaults(&self) -> &'static [Patch] {
         &[]

@@ -142,10 +142,6 @@ pub trait NodeDictionary: EntryAccess {
     /// every stored entry, split where the index class changes.
     const STORED: &'static [image::Span];
 
-    /// The value image of the spec's defaults (the first mode's where they differ), before
-    /// [`NodeDictionary::NODE_ID_DEFAULTS`] and [`NodeDictionary::mode_defaults`].
-    const DEFAULTS: &'static [u8];
-
     /// The defaults that depend on the node-ID, in every mode.
     const NODE_ID_DEFAULTS: &'static [image::Patch];
 
@@ -155,7 +151,13 @@ pub trait NodeDictionary: EntryAccess {
     /// The optional communication objects the dictionary has in any mode.
     const COMM: CommObjects;
 
-    /// The defaults of the dictionary's mode that differ from [`NodeDictionary::DEFAULTS`].
+    /// The value image of the spec's defaults (the first mode's where they differ), before
+    /// [`NodeDictionary::NODE_ID_DEFAULTS`] and [`NodeDictionary::mode_defaults`].
+    fn defaults() -> &'static [u8]
+    where
+        Self: Sized;
+
+    /// The defaults of the dictionary's mode that differ from [`NodeDictionary::defaults`].
     fn mode_defaults(&self) -> &'static [image::Patch];
 
     /// Hands the image of every persistent entry of `area` to `sink` with its offset in the
@@ -172,10 +174,13 @@ pub trait NodeDictionary: EntryAccess {
 
     /// Sets every stored entry (RAM and persistent) of `area` back to its spec default,
     /// `$NODEID` resolved for `node_id`. App-backed entries are the device's business.
-    fn reset_area(&mut self, area: Area, node_id: u8) {
+    fn reset_area(&mut self, area: Area, node_id: u8)
+    where
+        Self: Sized,
+    {
         let patches = self.mode_defaults();
         let image = self.image_mut();
-        image::reset(image, Self::DEFAULTS, Self::STORED, area);
+        image::reset(image, Self::defaults(), Self::STORED, area);
         image::patch(image, Self::NODE_ID_DEFAULTS, area, node_id);
         image::patch(image, patches, area, node_id);
     }

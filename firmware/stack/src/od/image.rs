@@ -233,11 +233,7 @@ mod tests {
         assert_eq!(image, [0]);
     }
 
-    const SPANS: [Span; 3] = [
-        Span { index: 0x1005, start: 0, len: 4 },
-        Span { index: 0x2000, start: 4, len: 2 },
-        Span { index: 0x6000, start: 8, len: 2 },
-    ];
+    const SPANS: [Span; 3] = [Span { index: 0x1005, start: 0, len: 4 }, Span { index: 0x2000, start: 4, len: 2 }, Span { index: 0x6000, start: 8, len: 2 }];
 
     #[test]
     fn a_reset_takes_the_defaults_and_patches_of_its_area_only() {
