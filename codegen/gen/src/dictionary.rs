@@ -446,7 +446,12 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
 
         /// The spec's defaults (the first mode's where the modes differ; `$NODEID` ones
         /// without the node-ID, which `NODE_ID_DEFAULTS` adds).
-        pub static DEFAULT_VALUES: Values = Values { #(#defaults),* };
+        pub const DEFAULT_VALUES: Values = Values { #(#defaults),* };
+
+        /// [`DEFAULT_VALUES`] as bytes, and in the sparse form kept in flash (most defaults
+        /// are 0).
+        const DEFAULT_IMAGE: [u8; ::core::mem::size_of::<Values>()] = #zerocopy::transmute!(DEFAULT_VALUES);
+        static DEFAULTS: [u8; #stack::od::image::sparse_len(&DEFAULT_IMAGE)] = #stack::od::image::sparse(&DEFAULT_IMAGE);
 
         /// The spans NMT resets set back to the defaults.
         static STORED: [#stack::od::image::Span; #stored_n] = [#(#stored),*];
@@ -492,7 +497,7 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             /// `node_id`.
             pub fn new(mode: Mode, node_id: u8, app: A) -> Self {
                 use #stack::od::NodeDictionary as _;
-                let mut od = Od { mode, app, values: DEFAULT_VALUES };
+                let mut od = Od { mode, app, values: #zerocopy::FromZeros::new_zeroed() };
                 od.reset_area(#stack::od::Area::ALL, node_id);
                 od
             }
@@ -518,7 +523,7 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
                 #stack::od::CommObjects { error_history: #history, sync_cycle: #sync_cycle, heartbeat_consumer: #consumer };
 
             fn defaults() -> &'static [u8] {
-                #zerocopy::IntoBytes::as_bytes(&DEFAULT_VALUES)
+                &DEFAULTS
             }
 
             fn mode_defaults(&self) -> &'static [#stack::od::image::Patch] {

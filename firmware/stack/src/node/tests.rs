@@ -6,7 +6,7 @@
 use super::{BusState, Node, NodeConfig, NodeEvent};
 use crate::emcy::{EmcyDefault, EmcyEvent, Reaction};
 use crate::frame::CanFrame;
-use crate::od::image::{Patch, Span};
+use crate::od::image::{self, Patch, Span};
 use crate::od::{
     Access, AppObjects, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NodeDictionary, ReadLen, SdoAbort,
     Side, Storage, WriteSource, read_slice,
@@ -97,7 +97,7 @@ static ENTRIES: [EntryInfo; ENTRY_COUNT] = {
 
 /// The defaults' image: each default little-endian in its slot (a byte entry reads its first
 /// byte), the `$NODEID` ones as patches.
-static DEFAULTS: [u8; IMAGE] = {
+const DEFAULT_IMAGE: [u8; IMAGE] = {
     let mut out = [0; IMAGE];
     let mut i = 0;
     while i < ENTRY_COUNT {
@@ -232,6 +232,7 @@ impl NodeDictionary for TestOd {
     const COMM: CommObjects = CommObjects { error_history: false, sync_cycle: false, heartbeat_consumer: true };
 
     fn defaults() -> &'static [u8] {
+        static DEFAULTS: [u8; image::sparse_len(&DEFAULT_IMAGE)] = image::sparse(&DEFAULT_IMAGE);
         &DEFAULTS
     }
 

@@ -152,7 +152,8 @@ pub trait NodeDictionary: EntryAccess {
     const COMM: CommObjects;
 
     /// The value image of the spec's defaults (the first mode's where they differ), before
-    /// [`NodeDictionary::NODE_ID_DEFAULTS`] and [`NodeDictionary::mode_defaults`].
+    /// [`NodeDictionary::NODE_ID_DEFAULTS`] and [`NodeDictionary::mode_defaults`], in the
+    /// sparse form of [`image::sparse`].
     fn defaults() -> &'static [u8]
     where
         Self: Sized;

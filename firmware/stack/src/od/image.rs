@@ -99,12 +99,86 @@ pub struct Patch {
     pub value: u32,
 }
 
-/// Sets the spans of `area` back to `defaults`, the image of the spec's defaults.
-pub fn reset(image: &mut [u8], defaults: &[u8], spans: &[Span], area: super::Area) {
-    for span in spans.iter().filter(|s| area.contains(s.index)) {
-        if let (Some(dst), Some(src)) = (image.get_mut(span.range()), defaults.get(span.range())) {
-            dst.copy_from_slice(src);
+/// The defaults as a generated dictionary keeps them in flash: the value image of its spec
+/// defaults without most of its zeros (most entries default to 0). A series of records, each
+/// `[zeros, n, n bytes]`: skip `zeros` zero bytes, then `n` bytes as given; 255 in a count
+/// is as far as one record reaches, the next goes on.
+///
+/// [`sparse_len`] and [`sparse`] make it at compile time from the image.
+pub const fn sparse_len(image: &[u8]) -> usize {
+    let (mut at, mut len) = (0, 0);
+    while at < image.len() {
+        let (zeros, n) = next_record(image, at);
+        len += 2 + n;
+        at += zeros + n;
+    }
+    len
+}
+
+/// The sparse form of `image` ([`sparse_len`] bytes: `N`).
+#[allow(clippy::indexing_slicing)] // Const code: `at + i < image.len()` and `len + i < N` by construction.
+pub const fn sparse<const N: usize>(image: &[u8]) -> [u8; N] {
+    let mut out = [0; N];
+    let (mut at, mut len) = (0, 0);
+    while at < image.len() && len + 2 <= N {
+        let (zeros, n) = next_record(image, at);
+        out[len] = zeros as u8;
+        out[len + 1] = n as u8;
+        let mut i = 0;
+        while i < n && len + 2 + i < N {
+            out[len + 2 + i] = image[at + zeros + i];
+            i += 1;
         }
+        len += 2 + n;
+        at += zeros + n;
+    }
+    out
+}
+
+/// From `at`: how many zero bytes to skip, then how many bytes to give (a run ends at 3 zeros
+/// in a row, where a new record is cheaper than the zeros).
+#[allow(clippy::indexing_slicing)] // Const code: every index is checked against `image.len()`.
+const fn next_record(image: &[u8], at: usize) -> (usize, usize) {
+    let mut zeros = 0;
+    while at + zeros < image.len() && image[at + zeros] == 0 && zeros < 255 {
+        zeros += 1;
+    }
+    let start = at + zeros;
+    let mut n = 0;
+    while start + n < image.len() && n < 255 {
+        let zero_run = start + n + 2 < image.len() && image[start + n] == 0 && image[start + n + 1] == 0 && image[start + n + 2] == 0;
+        if zero_run {
+            break;
+        }
+        n += 1;
+    }
+    // Trailing zeros of the image are left to the clearing.
+    while n > 0 && image[start + n - 1] == 0 {
+        n -= 1;
+    }
+    (zeros, n)
+}
+
+/// Sets the spans of `area` back to the defaults ([`sparse`] form).
+pub fn reset(image: &mut [u8], defaults: &[u8], spans: &[Span], area: super::Area) {
+    let in_area = || spans.iter().filter(|s| area.contains(s.index)).map(Span::range);
+    for range in in_area() {
+        if let Some(bytes) = image.get_mut(range) {
+            bytes.fill(0);
+        }
+    }
+    let (mut at, mut rest) = (0, defaults);
+    while let [zeros, n, tail @ ..] = rest {
+        let (n, start) = (usize::from(*n), at + usize::from(*zeros));
+        let Some((given, tail)) = tail.split_at_checked(n) else { break };
+        for range in in_area() {
+            // The part of the record's bytes inside the span.
+            let (from, to) = (range.start.max(start), range.end.min(start + n));
+            if let (Some(dst), Some(src)) = (image.get_mut(from..to), given.get(from.wrapping_sub(start)..to.wrapping_sub(start))) {
+                dst.copy_from_slice(src);
+            }
+        }
+        (at, rest) = (start + n, tail);
     }
 }
 
@@ -237,21 +311,52 @@ mod tests {
 
     #[test]
     fn a_reset_takes_the_defaults_and_patches_of_its_area_only() {
-        let defaults = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10];
-        let mut image = [0_u8; 10];
-        reset(&mut image, &defaults, &SPANS, Area::COMMUNICATION);
-        assert_eq!(image, [1, 2, 3, 4, 0, 0, 0, 0, 0, 0]);
-        reset(&mut image, &defaults, &SPANS, Area::ALL);
+        const IMAGE: [u8; 10] = [1, 2, 3, 4, 5, 6, 7, 8, 9, 0];
+        const DEFAULTS: [u8; sparse_len(&IMAGE)] = sparse(&IMAGE);
+        let mut image = [0xEE_u8; 10];
+        reset(&mut image, &DEFAULTS, &SPANS, Area::COMMUNICATION);
+        assert_eq!(image, [1, 2, 3, 4, 0xEE, 0xEE, 0xEE, 0xEE, 0xEE, 0xEE]);
+        reset(&mut image, &DEFAULTS, &SPANS, Area::ALL);
         // Bytes 6 and 7 belong to no span: a reset never touches them.
-        assert_eq!(image, [1, 2, 3, 4, 5, 6, 0, 0, 9, 10]);
+        assert_eq!(image, [1, 2, 3, 4, 5, 6, 0xEE, 0xEE, 9, 0]);
         let patches = [
             Patch { index: 0x1005, at: 0, width: 4, plus_node_id: true, value: 0x180 },
             Patch { index: 0x6000, at: 8, width: 1, plus_node_id: false, value: 0x10 },
         ];
         patch(&mut image, &patches, Area::COMMUNICATION, 5);
-        assert_eq!(image, [0x85, 1, 0, 0, 5, 6, 0, 0, 9, 10]);
+        assert_eq!(image, [0x85, 1, 0, 0, 5, 6, 0xEE, 0xEE, 9, 0]);
         patch(&mut image, &patches, Area::APPLICATION, 5);
-        assert_eq!(image[8..], [0x10, 10]);
+        assert_eq!(image[8..], [0x10, 0]);
+    }
+
+    /// Every image of up to 12 bytes of 0, 1 and 0xFF, and long runs of zeros and of bytes:
+    /// the sparse form resets to exactly the image, and is no longer than needed.
+    #[test]
+    fn sparse_defaults_reset_to_the_image() {
+        fn round_trip(img: &[u8]) {
+            let mut buf = std::vec![0_u8; sparse_len(img)];
+            let n = buf.len();
+            // `sparse` wants a constant length: through the largest used here.
+            let full: [u8; 1200] = sparse(img);
+            buf.copy_from_slice(&full[..n]);
+            assert!(full[n..].iter().all(|&b| b == 0));
+            let spans = [Span { index: 0x2000, start: 0, len: img.len() as u16 }];
+            let mut out = std::vec![0xA5_u8; img.len()];
+            reset(&mut out, &buf, &spans, Area::ALL);
+            assert_eq!(out, img, "sparse form {buf:?}");
+        }
+        for len in 0..=8_u32 {
+            for pattern in 0..3_u32.pow(len) {
+                let img: std::vec::Vec<u8> = (0..len).map(|i| [0, 1, 0xFF][(pattern / 3_u32.pow(i) % 3) as usize]).collect();
+                round_trip(&img);
+            }
+        }
+        let mut long = std::vec![0_u8; 700];
+        long[600..690].fill(7);
+        long[3] = 1;
+        round_trip(&long);
+        round_trip(&[9; 600]);
+        assert_eq!(sparse_len(&[0; 700]), 6, "700 zeros: three records of skips, nothing given");
     }
 
     #[test]
