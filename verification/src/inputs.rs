@@ -5,7 +5,7 @@
 
 use coforge_stack::device::{Device, HostPort};
 use coforge_stack::frame::CanFrame;
-use coforge_stack::od::{Access, EntryInfo, HostAccess, ReadLen, SdoAbort};
+use coforge_stack::od::{Access, HostAccess, ReadLen, SdoAbort, Table};
 
 /// The longest value compared (strings included).
 const VALUE: usize = 32;
@@ -99,7 +99,7 @@ pub struct Snapshot {
 
 impl Snapshot {
     /// Reads every sub-index of `entries` with `read` (the device side), but `maintained`.
-    pub fn take(entries: &[EntryInfo], maintained: &[u16], mut read: impl FnMut(u16, u8, &mut [u8]) -> Result<ReadLen, SdoAbort>) -> Snapshot {
+    pub fn take(entries: Table<'_>, maintained: &[u16], mut read: impl FnMut(u16, u8, &mut [u8]) -> Result<ReadLen, SdoAbort>) -> Snapshot {
         let mut s = Snapshot { values: [None; WATCHED], n: 0 };
         for e in entries.iter().filter(|e| !maintained.contains(&e.index)) {
             for sub in e.sub..=e.last_sub {

@@ -10,7 +10,7 @@
 use coforge_stack::device::{Assemble, NodeAccess};
 use coforge_stack::frame::CanFrame;
 use coforge_stack::node::Node;
-use coforge_stack::od::{Access, EntryInfo, NoAppObjects, NodeDictionary, SdoAbort, Side};
+use coforge_stack::od::{Access, NoAppObjects, NodeDictionary, SdoAbort, Side, Table};
 use coforge_stack::store::{BlockStore, ParamStore};
 use coforge_storage::ram::RamEeprom;
 
@@ -76,7 +76,7 @@ fn assembled<T: Assemble<RamEeprom<[u8; STORE]>>>() -> T {
 
 type Snapshot = ([(u16, u8, usize, [u8; VALUE]); MAX_WATCHED], usize);
 
-fn snapshot(node: &mut dyn NodeAccess, entries: &[EntryInfo]) -> Snapshot {
+fn snapshot(node: &mut dyn NodeAccess, entries: Table<'_>) -> Snapshot {
     let mut out = ([(0, 0, 0, [0; VALUE]); MAX_WATCHED], 0);
     let watched = entries.iter().filter(|e| matches!(e.access(), Access::Ro | Access::Const) && !STACK_MAINTAINED.contains(&e.index));
     for e in watched {

@@ -38,7 +38,7 @@ fn check<D: NodeDictionary, const S: usize>(make: impl Fn(D::Mode) -> D, seed: u
         let mut cells = ImageCells::<S>::over(&od, std::array::from_fn(|_| rng.u8(..)));
         let table = od.entries();
         for _ in 0..CASES / D::MODES.len() {
-            let run = &table[rng.u64(..table.len() as u64) as usize];
+            let run = table.iter().nth(rng.u64(..table.len() as u64) as usize).expect("a run of the table");
             let (index, sub) = match rng.u64(..8) {
                 // Now and then anywhere: missing objects and sub-indices.
                 0 => (rng.u64(..) as u16, rng.u64(..) as u8),
@@ -112,7 +112,7 @@ fn cells_behave_as_fields<D: NodeDictionary, const S: usize>(make: impl Fn(D::Mo
     for &mode in D::MODES {
         let mut od = make(mode);
         let mut cells = ImageCells::<S>::over(&od, od.image().try_into().expect("the image is S bytes"));
-        for run in od.entries() {
+        for run in od.entries().iter() {
             for index in (0..=u16::from(run.copies())).map(|k| run.index + k) {
                 for sub in run.sub..=run.last_sub {
                     let size = usize::from(run.size);

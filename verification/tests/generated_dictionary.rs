@@ -2,7 +2,7 @@
 //! resolved, access per side and NMT state, abort codes, app-backed routing, modes; and every
 //! entry of every device can be read and written back through the generated dispatch.
 
-use coforge_stack::od::{AccessContext, AppObjects, EntryAccess, EntryInfo, NmtState, ReadLen, SdoAbort, Side, read_slice};
+use coforge_stack::od::{AccessContext, AppObjects, EntryAccess, EntryInfo, NmtState, ReadLen, SdoAbort, Side, Table, read_slice};
 
 /// App-backed storage for tests: one byte per (index, sub), like CO401Memory1's banks.
 #[derive(Debug, Clone)]
@@ -32,9 +32,9 @@ fn read(od: &mut impl EntryAccess, index: u16, sub: u8, side: Side) -> Result<Ve
 }
 
 /// Reads every entry as the device and writes the value back: every dispatch arm runs.
-fn sweep(od: &mut impl EntryAccess, table: &[EntryInfo]) -> usize {
+fn sweep(od: &mut impl EntryAccess, table: Table<'_>) -> usize {
     let mut n = 0;
-    for run in table {
+    for run in table.iter() {
         for index in run.index..=run.index + u16::from(run.copies()) {
             for sub in run.sub..=run.last_sub {
                 let value = read(od, index, sub, Side::Device).unwrap_or_else(|a| panic!("{index:04X}.{sub}: {a:?}"));

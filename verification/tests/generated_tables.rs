@@ -4,7 +4,7 @@
 
 use coforge_spec::model::{Device, PdoDir, in_mode};
 use coforge_spec::types::WriteWhen;
-use coforge_stack::od::{EntryInfo, find};
+use coforge_stack::od::{Table, find};
 use coforge_stack::pdo::PdoDefault;
 use std::path::PathBuf;
 
@@ -13,10 +13,11 @@ fn spec(name: &str) -> Device {
     coforge_spec::load_file(&path).into_device().unwrap_or_else(|| panic!("{name} loads"))
 }
 
-fn check(d: &Device, mode: Option<&str>, table: &[EntryInfo], rpdos: &[PdoDefault], tpdos: &[PdoDefault]) {
+fn check(d: &Device, mode: Option<&str>, table: Table<'_>, rpdos: &[PdoDefault], tpdos: &[PdoDefault]) {
     let ctx = format!("{} {:?}", d.identity.name, mode);
     // Sorted, non-overlapping runs.
-    assert!(table.windows(2).all(|w| (w[0].index, w[0].last_sub) < (w[1].index, w[1].sub)), "{ctx}: table order");
+    let runs: Vec<_> = table.iter().collect();
+    assert!(runs.windows(2).all(|w| (w[0].index, w[0].last_sub) < (w[1].index, w[1].sub)), "{ctx}: table order");
     let mut covered = 0_usize;
     for o in d.objects.iter().filter(|o| in_mode(&o.modes, mode)) {
         for e in o.entries.iter().filter(|e| in_mode(&e.modes, mode)) {

@@ -563,7 +563,7 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
         impl<A: #stack::od::AppObjects> #stack::od::EntryAccess for Od<A> {
             type App = A;
 
-            fn entries(&self) -> &'static [#stack::od::EntryInfo] {
+            fn entries(&self) -> #stack::od::Table<'static> {
                 od::entries(self.mode)
             }
 

@@ -5,7 +5,7 @@ use crate::modes::Modes;
 use coforge_spec::model::{Device, Entry, Object, Value, in_mode};
 use coforge_spec::types::{DataType, NmtState, WriteWhen};
 use proc_macro2::{Ident, Span, TokenStream};
-use quote::quote;
+use quote::{ToTokens, quote};
 
 /// Value limits of an entry: (low, high, allowed values).
 type LimitsKey = (Option<i64>, Option<i64>, Vec<i64>);
@@ -169,6 +169,43 @@ fn run_tokens(r: &Run, offset: TokenStream, stack: &TokenStream, limits: &mut Ve
     }
 }
 
+/// `ENTRIES`, every run of every mode once, and per mode the positions of its runs
+/// (`PICK_<MODE>`, shared by modes with equal tables), with the `match mode` selecting each
+/// mode's `Table`. A device whose modes all have one table has no picks.
+fn table(modes: &Modes, per_mode: &[Vec<TokenStream>], stack: &TokenStream) -> (Vec<TokenStream>, TokenStream) {
+    let (mut all, mut keys): (Vec<&TokenStream>, Vec<String>) = (Vec::new(), Vec::new());
+    let picks: Vec<Vec<usize>> = per_mode
+        .iter()
+        .map(|runs| {
+            runs.iter()
+                .map(|r| {
+                    let key = r.to_string();
+                    keys.iter().position(|k| *k == key).unwrap_or_else(|| {
+                        keys.push(key);
+                        all.push(r);
+                        all.len() - 1
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    let count = crate::dec(all.len() as u64);
+    let mut statics = vec![quote!(static ENTRIES: [#stack::od::EntryInfo; #count] = [#(#all),*];)];
+    if picks.iter().all(|p| p.len() == all.len()) {
+        // Every mode has every run (in the one sorted order there is).
+        let arms = vec![quote!(#stack::od::Table::new(&ENTRIES)); modes.variants.len()];
+        return (statics, modes.select(&arms));
+    }
+    if all.len() > 256 {
+        let error = format!("the modes' entry tables have {} distinct runs; a table of several modes holds at most 256", all.len());
+        statics.push(quote!(::core::compile_error!(#error);));
+    }
+    let per_mode_picks: Vec<Vec<TokenStream>> = picks.iter().map(|p| p.iter().map(|&i| crate::dec(i as u64).into_token_stream()).collect()).collect();
+    let (pick_statics, select) = modes.tables_as("PICK", &quote!(u8), &per_mode_picks, |pick| quote!(#stack::od::Table::picked(&ENTRIES, &#pick)));
+    statics.extend(pick_statics);
+    (statics, select)
+}
+
 pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let stack = &options.stack;
     let mut limits: Vec<LimitsKey> = Vec::new();
@@ -177,7 +214,7 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
     let offset = |r: &Run| offsets.get(&(r.index, r.sub)).cloned().filter(|_| r.meta.storage != "App").unwrap_or_else(|| quote!(0));
     let per_mode: Vec<Vec<TokenStream>> =
         modes.variants.iter().map(|(_, mode)| runs(d, mode.as_deref()).iter().map(|r| run_tokens(r, offset(r), stack, &mut limits)).collect()).collect();
-    let (tables, select) = modes.tables("ENTRIES", &quote!(#stack::od::EntryInfo), &per_mode);
+    let (tables, select) = table(modes, &per_mode, stack);
     let limit_items: Vec<TokenStream> = limits
         .iter()
         .map(|(low, high, values)| {
@@ -215,7 +252,7 @@ pub fn od_module(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
             /// are described alike share one run (`sub..=last_sub`).
             // Every engine looks entries up: one call each, not the `match` in every caller.
             #[inline(never)]
-            pub fn entries(mode: Mode) -> &'static [#stack::od::EntryInfo] {
+            pub fn entries(mode: Mode) -> #stack::od::Table<'static> {
                 #select
             }
         }

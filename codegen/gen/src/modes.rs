@@ -46,8 +46,20 @@ impl Modes {
 
     /// One `static PREFIX_MODE: [ty; n]` per distinct table of `per_mode` (the items of each
     /// mode's table), named after the first mode that has it, and the `match mode` returning
-    /// each mode's: rustc does not merge identical statics, so modes with equal tables share one.
+    /// each mode's `&PREFIX_MODE`: rustc does not merge identical statics, so modes with equal
+    /// tables share one.
     pub fn tables(&self, prefix: &str, ty: &TokenStream, per_mode: &[Vec<TokenStream>]) -> (Vec<TokenStream>, TokenStream) {
+        self.tables_as(prefix, ty, per_mode, |name| quote!(&#name))
+    }
+
+    /// [`Modes::tables`], each mode's arm being `arm(static's name)`.
+    pub fn tables_as(
+        &self,
+        prefix: &str,
+        ty: &TokenStream,
+        per_mode: &[Vec<TokenStream>],
+        arm: impl Fn(&Ident) -> TokenStream,
+    ) -> (Vec<TokenStream>, TokenStream) {
         let mut statics = Vec::new();
         // (the items as text, the static's name) of each table emitted so far.
         let mut emitted: Vec<(String, Ident)> = Vec::new();
@@ -64,7 +76,7 @@ impl Modes {
                     name
                 }
             };
-            refs.push(quote!(&#name));
+            refs.push(arm(&name));
         }
         (statics, self.select(&refs))
     }

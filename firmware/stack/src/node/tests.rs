@@ -9,7 +9,7 @@ use crate::frame::CanFrame;
 use crate::od::image::{self, Patch, Span};
 use crate::od::{
     Access, AppObjects, Area, CommObjects, DataType, EntryAccess, EntryFlags, EntryInfo, EntryKind, HostAccess, Limits, NodeDictionary, ReadLen, SdoAbort,
-    Side, Storage, WriteSource, read_slice,
+    Side, Storage, Table, WriteSource, read_slice,
 };
 use crate::store::NoStore;
 use coforge_types::NmtState;
@@ -201,8 +201,8 @@ pub(super) struct TestOd {
 impl EntryAccess for TestOd {
     type App = Recorder;
 
-    fn entries(&self) -> &'static [EntryInfo] {
-        &ENTRIES
+    fn entries(&self) -> Table<'static> {
+        Table::new(&ENTRIES)
     }
 
     fn limits(&self) -> &'static [Limits] {

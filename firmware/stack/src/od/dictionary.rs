@@ -1,7 +1,7 @@
 //! The traits generated dictionaries implement: entry access (`EntryAccess`), what a node
 //! needs beyond it (`NodeDictionary`), and the owner of app-backed objects (`AppObjects`).
 
-use super::{AccessContext, EntryInfo, Limits, ReadLen, SdoAbort, Side, WriteSource, find, image};
+use super::{AccessContext, EntryInfo, Limits, ReadLen, SdoAbort, Side, Table, WriteSource, find, image};
 use coforge_types::Storage;
 
 /// The dictionary of one device: implemented by the code `device!` generates.
@@ -14,8 +14,9 @@ pub trait EntryAccess {
     /// Where app-backed entries (`storage: app`) are read and written.
     type App: AppObjects;
 
-    /// Every entry description, sorted by index and sub-index (see [`find`]).
-    fn entries(&self) -> &'static [EntryInfo];
+    /// The entry descriptions of the dictionary's mode, sorted by index and sub-index (see
+    /// [`find`]).
+    fn entries(&self) -> Table<'static>;
 
     /// The value limits the entries' `limits` indices refer to.
     fn limits(&self) -> &'static [Limits];

@@ -29,7 +29,7 @@ pub use abort::SdoAbort;
 pub use coforge_types::{Access, DataType, HostAccess, NmtState, Storage};
 pub use dictionary::{AppObjects, Area, CommObjects, EntryAccess, NoAppObjects, NodeDictionary, mode_named};
 pub use entry::{EntryFlags, EntryInfo, EntryKind, Limits, ReadLen, decode_int};
-pub use lookup::{find, find_run, read_slice};
+pub use lookup::{Table, find, find_run, read_slice};
 pub use side::{AccessContext, NmtStates, Side, WriteSource};
 
 #[cfg(test)]

@@ -8,7 +8,7 @@
 //! refused write changes nothing.
 #![allow(clippy::panic)]
 
-use super::{Access, AccessContext, EntryAccess, EntryInfo, HostAccess, Limits, NoAppObjects, SdoAbort, Side, Storage};
+use super::{Access, AccessContext, EntryAccess, EntryInfo, HostAccess, Limits, NoAppObjects, SdoAbort, Side, Storage, Table};
 
 /// The longest value the properties read back.
 const BUF: usize = 16;
@@ -108,7 +108,7 @@ pub fn prop_read_is_checked<D: EntryAccess>(od: &mut D, index: u16, sub: u8, sid
 /// app-backed entries (whose owners serve them, not the dictionary) answer as absent.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImageCells<const S: usize> {
-    entries: &'static [EntryInfo],
+    entries: Table<'static>,
     limits: &'static [Limits],
     app: NoAppObjects,
     image: [u8; S],
@@ -126,7 +126,7 @@ impl<const S: usize> ImageCells<S> {
 impl<const S: usize> EntryAccess for ImageCells<S> {
     type App = NoAppObjects;
 
-    fn entries(&self) -> &'static [EntryInfo] {
+    fn entries(&self) -> Table<'static> {
         self.entries
     }
 

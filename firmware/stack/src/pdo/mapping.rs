@@ -2,7 +2,7 @@
 //! mapped values into a frame.
 
 use super::Dir;
-use crate::od::{EntryAccess, EntryInfo, SdoAbort, find_run};
+use crate::od::{EntryAccess, EntryInfo, SdoAbort, Table, find_run};
 
 /// Most entries a PDO maps (one per byte of a CAN frame).
 pub const MAX_MAPPED: usize = 8;
@@ -51,7 +51,7 @@ impl Mapped {
     }
 
     /// The mapped entry's description.
-    pub fn info<'t>(&self, entries: &'t [EntryInfo]) -> Option<&'t EntryInfo> {
+    pub fn info<'t>(&self, entries: Table<'t>) -> Option<&'t EntryInfo> {
         entries.get(usize::from(self.run))
     }
 }
@@ -138,7 +138,7 @@ impl Mapping {
         self.count == 0
     }
 
-    pub fn contains(&self, entries: &[EntryInfo], index: u16, sub: u8) -> bool {
+    pub fn contains(&self, entries: Table<'_>, index: u16, sub: u8) -> bool {
         self.entries().iter().any(|e| e.sub == sub && e.info(entries).is_some_and(|i| e.index(i) == index))
     }
 

@@ -7,7 +7,7 @@
 
 use super::check::{PDO_TABLES, SERVED_BY_FIRMWARE, mapped};
 use coforge_beds::{BinaryEds, PdoRecord, Table};
-use coforge_stack::od::{Area, EntryInfo, find};
+use coforge_stack::od::{Area, Table as Entries, find};
 use coforge_stack::pdo::{COB_INVALID, Dir};
 
 /// Entries a file lists that are not configuration: what the firmware serves itself
@@ -26,7 +26,7 @@ pub type Write<'w> = dyn FnMut(u16, u8, &[u8]) -> bool + 'w;
 ///
 /// The format stores 0 in the process image where a default depends on the node-ID or is
 /// absent (erratum COIA-39): a zero the dictionary refuses is that, not a refused value.
-pub fn apply(file: &BinaryEds<'_>, entries: &[EntryInfo], area: Area, node_id: u8, write: &mut Write<'_>) -> u32 {
+pub fn apply(file: &BinaryEds<'_>, entries: Entries<'_>, area: Area, node_id: u8, write: &mut Write<'_>) -> u32 {
     let mut refused = 0;
     let mut value = |index: u16, sub: u8, data: &[u8]| {
         if !write(index, sub, data) && data.iter().any(|&b| b != 0) {
@@ -66,13 +66,13 @@ pub fn apply(file: &BinaryEds<'_>, entries: &[EntryInfo], area: Area, node_id: u
 }
 
 /// Sub-index 0 of an array or record: the dictionary's structure, not a value to take.
-fn is_structure(entries: &[EntryInfo], index: u16, sub: u8) -> bool {
+fn is_structure(entries: Entries<'_>, index: u16, sub: u8) -> bool {
     sub == 0 && find(entries, index, 1).is_ok()
 }
 
 /// The file's PDOs of one direction; the dictionary's PDOs the file does not configure are
 /// made invalid.
-fn pdos(file: &BinaryEds<'_>, entries: &[EntryInfo], table: Table, dir: Dir, node_id: u8, write: &mut dyn FnMut(u16, u8, &[u8])) {
+fn pdos(file: &BinaryEds<'_>, entries: Entries<'_>, table: Table, dir: Dir, node_id: u8, write: &mut dyn FnMut(u16, u8, &[u8])) {
     let base = dir.comm_base();
     let mut configured = 0_u64;
     for pdo in file.pdos(table) {

@@ -14,14 +14,14 @@
 
 use coforge_beds::layout::func;
 use coforge_beds::{BinaryEds, OdEntry, PdoRecord, Table};
-use coforge_stack::od::{EntryInfo, SdoAbort, find};
+use coforge_stack::od::{SdoAbort, Table as Entries, find};
 use coforge_stack::pdo::Dir;
 
 /// The bit rates of CiA 301's bit timing table, in kbit/s.
 const BIT_RATES: [u16; 9] = [10, 20, 50, 100, 125, 250, 500, 800, 1000];
 
 /// Checks `file` against the dictionary `entries`.
-pub fn check(file: &BinaryEds<'_>, entries: &[EntryInfo]) -> Result<(), SdoAbort> {
+pub fn check(file: &BinaryEds<'_>, entries: Entries<'_>) -> Result<(), SdoAbort> {
     check_settings(file)?;
     for r in file.sdo_replies() {
         check_entry(entries, r.index, r.sub, u16::from(r.size().unwrap_or(4)))?;
@@ -53,13 +53,13 @@ fn check_settings(file: &BinaryEds<'_>) -> Result<(), SdoAbort> {
 
 /// Sub-index 0 of an array or record tells its highest sub-index: the dictionary's structure
 /// decides it, so a file may list fewer sub-entries, not more.
-fn check_entry(entries: &[EntryInfo], index: u16, sub: u8, size: u16) -> Result<(), SdoAbort> {
+fn check_entry(entries: Entries<'_>, index: u16, sub: u8, size: u16) -> Result<(), SdoAbort> {
     let info = find(entries, index, sub)?;
     if info.takes_len(usize::from(size)) { Ok(()) } else { Err(SdoAbort::LengthMismatch) }
 }
 
 /// The dictionary must have the PDO's parameters, and its entries must be mappable.
-fn check_pdo(file: &BinaryEds<'_>, entries: &[EntryInfo], pdo: &PdoRecord, dir: Dir) -> Result<(), SdoAbort> {
+fn check_pdo(file: &BinaryEds<'_>, entries: Entries<'_>, pdo: &PdoRecord, dir: Dir) -> Result<(), SdoAbort> {
     let comm = pdo.number.checked_sub(1).map(|n| dir.comm_base() + u16::from(n)).ok_or(SdoAbort::NoObject)?;
     find(entries, comm, 1)?;
     find(entries, Dir::mapping_of(comm), 0)?;

@@ -17,7 +17,7 @@
 use super::check::check;
 use super::slots::{ConfigMemory, ConfigSlots, SlotError};
 use coforge_beds::BinaryEds;
-use coforge_stack::od::{EntryInfo, SdoAbort};
+use coforge_stack::od::{SdoAbort, Table};
 
 /// What the device has to do after the input that asked for it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,7 +48,7 @@ pub struct Program<M> {
     pub serial: u32,
     request: Option<ProgramRequest>,
     /// The dictionary a file is checked against.
-    entries: &'static [EntryInfo],
+    entries: Table<'static>,
 }
 
 fn storage_abort(e: SlotError) -> SdoAbort {
@@ -62,13 +62,13 @@ fn storage_abort(e: SlotError) -> SdoAbort {
 
 /// The active file of `slots`, checked again against `entries` (storage may have decayed since
 /// it was stored): `None` if there is none or it no longer passes.
-pub fn checked_active<'s, M: ConfigMemory>(slots: &'s ConfigSlots<M>, entries: &[EntryInfo]) -> Option<BinaryEds<'s>> {
+pub fn checked_active<'s, M: ConfigMemory>(slots: &'s ConfigSlots<M>, entries: Table<'_>) -> Option<BinaryEds<'s>> {
     let file = BinaryEds::parse(slots.active()?).ok()?;
     check(&file, entries).ok().map(|()| file)
 }
 
 impl<M: ConfigMemory> Program<M> {
-    pub fn new(memory: M, entries: &'static [EntryInfo]) -> Self {
+    pub fn new(memory: M, entries: Table<'static>) -> Self {
         Program { slots: Some(ConfigSlots::new(memory)), bootloader: false, key: false, serial: 0, request: None, entries }
     }
 
