@@ -404,7 +404,7 @@ fn patch_tokens(p: &PatchOf, stack: &TokenStream) -> TokenStream {
         _ => (false, 0),
     };
     let value = crate::hex(value as u32 as u64, 1);
-    quote!(#stack::od::image::Patch { index: #index, at: (#offset) as u16, width: #width, plus_node_id: #plus_node_id, value: #value })
+    quote!(#stack::od::image::Patch::new(#index, (#offset) as u16, #width, #plus_node_id, #value))
 }
 
 pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {

@@ -126,11 +126,11 @@ static SPANS: [Span; ENTRY_COUNT] = {
 
 /// The entries whose default adds the node-ID (1400h.1 and 1800h.1).
 static NODE_ID_DEFAULTS: [Patch; 2] = {
-    let mut out = [Patch { index: 0, at: 0, width: 0, plus_node_id: true, value: 0 }; 2];
+    let mut out = [Patch::new(0, 0, 0, true, 0); 2];
     let (mut i, mut n) = (0, 0);
     while i < ENTRY_COUNT {
         if TABLE[i].2 {
-            out[n] = Patch { index: TABLE[i].0.index, at: (SLOT * i) as u16, width: 4, plus_node_id: true, value: TABLE[i].1 };
+            out[n] = Patch::new(TABLE[i].0.index, (SLOT * i) as u16, 4, true, TABLE[i].1);
             n += 1;
         }
         i += 1;

@@ -88,15 +88,34 @@ impl Span {
 
 /// A default the value image of the defaults cannot hold: one that depends on the node-ID
 /// (`$NODEID + value` in the spec) or on the mode. `width` bytes (1..=4) little-endian at
-/// `at`, in the area of `index`.
+/// `at`, in the area of its index. Eight bytes, built with [`Patch::new`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Patch {
-    pub index: u16,
-    pub at: u16,
-    pub width: u8,
-    /// The node-ID is added to `value`.
-    pub plus_node_id: bool,
-    pub value: u32,
+    at: u16,
+    /// The index's high byte: enough to tell its [`Area`](super::Area), whose bounds are
+    /// multiples of 1000h.
+    page: u8,
+    /// Bits 0..=2: the width; bit 7: the node-ID is added to `value`.
+    kind: u8,
+    value: u32,
+}
+
+impl Patch {
+    pub const fn new(index: u16, at: u16, width: u8, plus_node_id: bool, value: u32) -> Patch {
+        Patch { at, page: (index >> 8) as u8, kind: (width & 7) | (plus_node_id as u8) << 7, value }
+    }
+
+    fn index(&self) -> u16 {
+        u16::from(self.page) << 8
+    }
+
+    fn width(&self) -> usize {
+        usize::from(self.kind & 7).min(4)
+    }
+
+    fn plus_node_id(&self) -> bool {
+        self.kind & 0x80 != 0
+    }
 }
 
 /// The defaults as a generated dictionary keeps them in flash: the value image of its spec
@@ -159,35 +178,40 @@ const fn next_record(image: &[u8], at: usize) -> (usize, usize) {
     (zeros, n)
 }
 
-/// Sets the spans of `area` back to the defaults ([`sparse`] form).
+/// Sets the spans of `area` back to the defaults ([`sparse`] form): one pass over the image,
+/// byte by byte (a reset is rare; small code matters more than speed here).
 pub fn reset(image: &mut [u8], defaults: &[u8], spans: &[Span], area: super::Area) {
-    let in_area = || spans.iter().filter(|s| area.contains(s.index)).map(Span::range);
-    for range in in_area() {
-        if let Some(bytes) = image.get_mut(range) {
-            bytes.fill(0);
+    let in_area = |at: usize| spans.iter().any(|s| area.contains(s.index) && s.range().contains(&at));
+    // The record being read: zeros still to give, then bytes still to give from `rest`.
+    let (mut zeros, mut given, mut rest) = (0_usize, 0_usize, defaults);
+    for (at, byte) in image.iter_mut().enumerate() {
+        while zeros == 0 && given == 0 {
+            let [z, n, tail @ ..] = rest else { break };
+            (zeros, given, rest) = (usize::from(*z), usize::from(*n), tail);
         }
-    }
-    let (mut at, mut rest) = (0, defaults);
-    while let [zeros, n, tail @ ..] = rest {
-        let (n, start) = (usize::from(*n), at + usize::from(*zeros));
-        let Some((given, tail)) = tail.split_at_checked(n) else { break };
-        for range in in_area() {
-            // The part of the record's bytes inside the span.
-            let (from, to) = (range.start.max(start), range.end.min(start + n));
-            if let (Some(dst), Some(src)) = (image.get_mut(from..to), given.get(from.wrapping_sub(start)..to.wrapping_sub(start))) {
-                dst.copy_from_slice(src);
-            }
+        let value = if zeros > 0 {
+            zeros -= 1;
+            0
+        } else if let ([b, tail @ ..], true) = (rest, given > 0) {
+            (given, rest) = (given - 1, tail);
+            *b
+        } else {
+            0
+        };
+        if in_area(at) {
+            *byte = value;
         }
-        (at, rest) = (start + n, tail);
     }
 }
 
-/// Applies the patches of `area`, the node-ID being `node_id`.
+/// Applies the patches of `area`, the node-ID being `node_id`. Not inlined: a reset calls
+/// it twice (the node-ID's defaults, the mode's).
+#[inline(never)]
 pub fn patch(image: &mut [u8], patches: &[Patch], area: super::Area, node_id: u8) {
-    for p in patches.iter().filter(|p| area.contains(p.index)) {
-        let value = if p.plus_node_id { p.value.wrapping_add(u32::from(node_id)) } else { p.value }.to_le_bytes();
+    for p in patches.iter().filter(|p| area.contains(p.index())) {
+        let value = if p.plus_node_id() { p.value.wrapping_add(u32::from(node_id)) } else { p.value }.to_le_bytes();
         let at = usize::from(p.at);
-        if let (Some(dst), Some(src)) = (image.get_mut(at..at + usize::from(p.width)), value.get(..usize::from(p.width))) {
+        if let (Some(dst), Some(src)) = (image.get_mut(at..at + p.width()), value.get(..p.width())) {
             dst.copy_from_slice(src);
         }
     }
@@ -319,10 +343,7 @@ mod tests {
         reset(&mut image, &DEFAULTS, &SPANS, Area::ALL);
         // Bytes 6 and 7 belong to no span: a reset never touches them.
         assert_eq!(image, [1, 2, 3, 4, 5, 6, 0xEE, 0xEE, 9, 0]);
-        let patches = [
-            Patch { index: 0x1005, at: 0, width: 4, plus_node_id: true, value: 0x180 },
-            Patch { index: 0x6000, at: 8, width: 1, plus_node_id: false, value: 0x10 },
-        ];
+        let patches = [Patch::new(0x1005, 0, 4, true, 0x180), Patch::new(0x6000, 8, 1, false, 0x10)];
         patch(&mut image, &patches, Area::COMMUNICATION, 5);
         assert_eq!(image, [0x85, 1, 0, 0, 5, 6, 0xEE, 0xEE, 9, 0]);
         patch(&mut image, &patches, Area::APPLICATION, 5);
