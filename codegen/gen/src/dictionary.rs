@@ -515,12 +515,22 @@ pub fn dictionary(d: &Device, modes: &Modes, options: &Options) -> TokenStream {
         impl<A: #stack::od::AppObjects> #stack::od::NodeDictionary for Od<A> {
             type Mode = Mode;
             const MODES: &'static [Mode] = &Mode::ALL;
-            const PERSISTENT: &'static [#stack::od::image::Span] = &PERSISTENT;
-            const STORED: &'static [#stack::od::image::Span] = &STORED;
-            const NODE_ID_DEFAULTS: &'static [#stack::od::image::Patch] = &NODE_ID_DEFAULTS;
+            const PERSISTENT_SIZE: usize = #stack::od::image::block_len(&PERSISTENT);
             const SDO_BLOCK_TRANSFER: bool = #block_transfer;
             const COMM: #stack::od::CommObjects =
                 #stack::od::CommObjects { error_history: #history, sync_cycle: #sync_cycle, heartbeat_consumer: #consumer };
+
+            fn persistent() -> &'static [#stack::od::image::Span] {
+                &PERSISTENT
+            }
+
+            fn stored() -> &'static [#stack::od::image::Span] {
+                &STORED
+            }
+
+            fn node_id_defaults() -> &'static [#stack::od::image::Patch] {
+                &NODE_ID_DEFAULTS
+            }
 
             fn defaults() -> &'static [u8] {
                 &DEFAULTS

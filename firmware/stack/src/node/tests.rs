@@ -225,11 +225,21 @@ impl EntryAccess for TestOd {
 impl NodeDictionary for TestOd {
     type Mode = ();
     const MODES: &'static [()] = &[()];
-    const PERSISTENT: &'static [Span] = &[];
-    const STORED: &'static [Span] = &SPANS;
-    const NODE_ID_DEFAULTS: &'static [Patch] = &NODE_ID_DEFAULTS;
+    const PERSISTENT_SIZE: usize = 0;
     const SDO_BLOCK_TRANSFER: bool = false;
     const COMM: CommObjects = CommObjects { error_history: false, sync_cycle: false, heartbeat_consumer: true };
+
+    fn persistent() -> &'static [Span] {
+        &[]
+    }
+
+    fn stored() -> &'static [Span] {
+        &SPANS
+    }
+
+    fn node_id_defaults() -> &'static [Patch] {
+        &NODE_ID_DEFAULTS
+    }
 
     fn defaults() -> &'static [u8] {
         static DEFAULTS: [u8; image::sparse_len(&DEFAULT_IMAGE)] = image::sparse(&DEFAULT_IMAGE);

@@ -134,17 +134,24 @@ pub trait NodeDictionary: EntryAccess {
 
     /// The persistent block: the spans of the value image that hold `storage: persistent`
     /// entries, in index order, whatever the mode (a block saved in one mode loads in another).
-    const PERSISTENT: &'static [image::Span];
+    /// (Functions rather than constants: a constant referring to a static is beyond Kani 0.63.)
+    fn persistent() -> &'static [image::Span]
+    where
+        Self: Sized;
 
-    /// Bytes of the persistent block.
-    const PERSISTENT_SIZE: usize = image::block_len(Self::PERSISTENT);
+    /// Bytes of the persistent block ([`image::block_len`] of [`NodeDictionary::persistent`]).
+    const PERSISTENT_SIZE: usize;
 
-    /// The spans of the value image a reset of an area sets back to [`NodeDictionary::DEFAULTS`]:
-    /// every stored entry, split where the index class changes.
-    const STORED: &'static [image::Span];
+    /// The spans of the value image a reset of an area sets back to the defaults: every
+    /// stored entry, split where the index class changes.
+    fn stored() -> &'static [image::Span]
+    where
+        Self: Sized;
 
     /// The defaults that depend on the node-ID, in every mode.
-    const NODE_ID_DEFAULTS: &'static [image::Patch];
+    fn node_id_defaults() -> &'static [image::Patch]
+    where
+        Self: Sized;
 
     /// Whether the SDO server does block transfer (the spec's `sdo_block_transfer`).
     const SDO_BLOCK_TRANSFER: bool;
@@ -153,7 +160,7 @@ pub trait NodeDictionary: EntryAccess {
     const COMM: CommObjects;
 
     /// The value image of the spec's defaults (the first mode's where they differ), before
-    /// [`NodeDictionary::NODE_ID_DEFAULTS`] and [`NodeDictionary::mode_defaults`], in the
+    /// [`NodeDictionary::node_id_defaults`] and [`NodeDictionary::mode_defaults`], in the
     /// sparse form of [`image::sparse`].
     fn defaults() -> &'static [u8]
     where
@@ -164,14 +171,20 @@ pub trait NodeDictionary: EntryAccess {
 
     /// Hands the image of every persistent entry of `area` to `sink` with its offset in the
     /// block, so the block is written without a buffer of its size; `false` if `sink` failed.
-    fn save_area(&self, area: Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool {
-        image::save(self.image(), Self::PERSISTENT, area, sink)
+    fn save_area(&self, area: Area, sink: &mut dyn FnMut(usize, &[u8]) -> bool) -> bool
+    where
+        Self: Sized,
+    {
+        image::save(self.image(), Self::persistent(), area, sink)
     }
 
     /// Loads every persistent entry of `area` from `source` (offset, buffer to fill); a piece
     /// `source` cannot give keeps its bytes, and the result is `false`.
-    fn load_area(&mut self, area: Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool {
-        image::load(self.image_mut(), Self::PERSISTENT, area, source)
+    fn load_area(&mut self, area: Area, source: &mut dyn FnMut(usize, &mut [u8]) -> bool) -> bool
+    where
+        Self: Sized,
+    {
+        image::load(self.image_mut(), Self::persistent(), area, source)
     }
 
     /// Sets every stored entry (RAM and persistent) of `area` back to its spec default,
@@ -182,8 +195,8 @@ pub trait NodeDictionary: EntryAccess {
     {
         let patches = self.mode_defaults();
         let image = self.image_mut();
-        image::reset(image, Self::defaults(), Self::STORED, area);
-        image::patch(image, Self::NODE_ID_DEFAULTS, area, node_id);
+        image::reset(image, Self::defaults(), Self::stored(), area);
+        image::patch(image, Self::node_id_defaults(), area, node_id);
         image::patch(image, patches, area, node_id);
     }
 
