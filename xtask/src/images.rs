@@ -35,23 +35,19 @@ const QEMU: Board = Board {
 
 /// Boards whose images do not fit their chip yet: `dist` tries to build them and reports by
 /// how much they are over, without failing. A board moves to [`BOARDS`] once it fits (the
-/// STM32F042K6 did).
-pub const PENDING: &[Board] = &[STM32F0_GW1, STM32F0_CANOPENIA];
+/// STM32F042K6 did, and the CO401GW1 image of the STM32F042C6).
+pub const PENDING: &[Board] = &[STM32F0_CANOPENIA];
 
-/// The STM32F042K6 board (`firmware/boards/stm32f0`): 32 KiB of flash, 6 KiB of RAM.
+/// The STM32F042 boards (`firmware/boards/stm32f0`): 32 KiB of flash, 6 KiB of RAM.
+/// CO401Memory1 on the K6 (LQFP32), CO401GW1 on the C6 (LQFP48): the same die.
 const STM32F0: Board = Board {
     name: "stm32f0",
     target: "thumbv6m-none-eabi",
-    devices: &["co401memory1"],
+    devices: &["co401memory1", "co401gw1"],
     features: &[],
     flash: (0x0800_0000, 32 * 1024),
     ram: (0x2000_0000, 6 * 1024),
 };
-
-/// CO401GW1 on the same crate's STM32F042C6 (LQFP48: the same 32 KiB / 6 KiB): its `[[bin]]`
-/// requires the feature `co401gw1-image` until it fits; then `co401gw1` joins [`STM32F0`]'s
-/// devices and the feature goes.
-const STM32F0_GW1: Board = Board { devices: &["co401gw1"], features: &["co401gw1-image"], ..STM32F0 };
 
 /// CANopenIA on the same crate's STM32F042K6, which the manual lists beside the coprocessor's
 /// own F091: its `[[bin]]` requires the feature `canopenia-image` until it fits.
@@ -65,7 +61,7 @@ const STM32F091: Board = Board { name: "stm32f091", devices: &["canopenia"], fla
 /// The STM32F072CB board (`firmware/boards/stm32f072`, the board code of `stm32f0` built for
 /// this chip): 128 KiB of flash, 16 KiB of RAM. The CR3101 with its SD card on SPI1 and the
 /// RTC, and the CO401GW1 on the gateway's STM32F042C6 board, with which the F072CB in LQFP48
-/// is pin-compatible (the F042C6 image is in [`PENDING`]).
+/// is pin-compatible (the bigger chip for a gateway that needs more room).
 const STM32F072: Board =
     Board { name: "stm32f072", devices: &["cr3101", "co401gw1"], flash: (0x0800_0000, 128 * 1024), ram: (0x2000_0000, 16 * 1024), ..STM32F0 };
 
@@ -341,13 +337,14 @@ mod tests {
         assert_eq!((parsed.device.as_str(), parsed.board.as_str(), parsed.chip.as_deref()), ("co401memory1", "stm32f0", Some("STM32F042K6Tx")));
         assert!(super::flash_args(&args("--device co401memory1")).unwrap_err().contains("--board"));
         assert!(super::flash_args(&args("--device")).unwrap_err().contains("needs a value"));
-        assert!(super::chip_of("qemu").unwrap_err().contains("QEMU"));
-        assert_eq!(super::chip_of("stm32f0"), Ok("STM32F042K6Tx"));
-        assert_eq!(super::chip_of("stm32f091"), Ok("STM32F091RCTx"));
-        assert_eq!(super::chip_of("stm32f072"), Ok("STM32F072CBTx"));
-        let nope = super::chip_of("nope").unwrap_err();
+        assert!(super::chip_of("qemu", "co401memory1").unwrap_err().contains("QEMU"));
+        assert_eq!(super::chip_of("stm32f0", "co401memory1"), Ok("STM32F042K6Tx"));
+        assert_eq!(super::chip_of("stm32f0", "co401gw1"), Ok("STM32F042C6Tx"));
+        assert_eq!(super::chip_of("stm32f091", "canopenia"), Ok("STM32F091RCTx"));
+        assert_eq!(super::chip_of("stm32f072", "co401gw1"), Ok("STM32F072CBTx"));
+        let nope = super::chip_of("nope", "co401gw1").unwrap_err();
         assert!(nope.contains("stm32f0, stm32f091"), "{nope}");
-        assert!(super::chip_of("nope").unwrap_err().contains("--chip"));
+        assert!(super::chip_of("nope", "co401gw1").unwrap_err().contains("--chip"));
     }
 
     #[test]
@@ -384,10 +381,13 @@ pub fn flash_args(args: &[String]) -> std::result::Result<FlashArgs, String> {
     Ok(FlashArgs { device, board, chip })
 }
 
-/// The probe-rs chip name of a board that is flashed, or why it is not.
-pub fn chip_of(board: &str) -> std::result::Result<&'static str, String> {
+/// The probe-rs chip name of a board (and device: the stm32f0 crate has two packages of the
+/// STM32F042) that is flashed, or why it is not.
+pub fn chip_of(board: &str, device: &str) -> std::result::Result<&'static str, String> {
     match board {
         "qemu" => Err("the qemu board's images run in QEMU, not on a probe: see \"Running an image in QEMU\" in README.md".into()),
+        // CO401GW1's board has the 48-pin package (PINS-co401gw1.md), CO401Memory1's the 32-pin.
+        "stm32f0" if device == "co401gw1" => Ok("STM32F042C6Tx"),
         "stm32f0" => Ok("STM32F042K6Tx"),
         "stm32f091" => Ok("STM32F091RCTx"),
         "stm32f072" => Ok("STM32F072CBTx"),
@@ -403,7 +403,7 @@ pub fn flash(args: &[String]) -> Result {
     let FlashArgs { device, board, chip } = flash_args(args)?;
     let chip = match chip {
         Some(c) => c,
-        None => chip_of(&board)?.to_string(),
+        None => chip_of(&board, &device)?.to_string(),
     };
     let elf = root().join("target/dist/images").join(format!("{device}-{board}.elf"));
     if !elf.exists() {

@@ -41,8 +41,7 @@
 //! reasons, the straps and the parameter store). Its 40 signals need 7 more pins than the
 //! 33 left after SWD, the crystal and BOOT0, so ID, BD and RSBD (read only at reset) go
 //! through the same two 74HC165 as above; CFG0..CFG2 are read at reset and then drive the
-//! LEDs and the watchdog. 1010h/1011h store into a 24C128 at 0x50. Not in dist yet: it does
-//! not fit the 32 KiB (feature `co401gw1-image`).
+//! LEDs and the watchdog. 1010h/1011h store into a 24C128 at 0x50.
 //!
 //! | Signal (datasheet) | STM32F042C6 pin (LQFP48 no.) | Use |
 //! |---|---|---|
@@ -76,8 +75,8 @@
 //! # CO401GW1 on the STM32F042C6 and the STM32F072CB
 //!
 //! [`gw1::run`] is the whole CO401GW1 image on the gateway's board (`PINS-co401gw1.md`): this
-//! crate's `co401gw1` for the STM32F042C6 (feature `co401gw1-image`, pending in `dist`: over
-//! the chip's flash), and `firmware/boards/stm32f072`'s for the pin-compatible STM32F072CB.
+//! crate's `co401gw1` for the STM32F042C6, and `firmware/boards/stm32f072`'s for the
+//! pin-compatible STM32F072CB.
 #![no_std]
 // One read of a status register (`serve::esr`), the GW1 board's port registers (`gw1::Ports`),
 // the F091's configuration flash (`config_flash`: programming and reading it in place) and the
