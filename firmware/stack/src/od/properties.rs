@@ -119,7 +119,13 @@ impl<const S: usize> ImageCells<S> {
     /// refused write changes nothing" is checked against any stored value, not only against
     /// the defaults.
     pub fn over<D: EntryAccess>(od: &D, image: [u8; S]) -> Self {
-        ImageCells { entries: od.entries(), limits: od.limits(), app: NoAppObjects, image }
+        Self::new(od.entries(), od.limits(), image)
+    }
+
+    /// A table and its limits over `image`, without a dictionary to take them from (the
+    /// harnesses: building one would unroll its reset over every byte of the image).
+    pub fn new(entries: Table<'static>, limits: &'static [Limits], image: [u8; S]) -> Self {
+        ImageCells { entries, limits, app: NoAppObjects, image }
     }
 }
 
