@@ -408,7 +408,7 @@ impl<B: Board, S: ParamStore> Gw1<B, S> {
         if reset {
             self.after_reset();
         }
-        let control = self.node.od().gateway_transfer_control.clone();
+        let control = self.node.od().gateway_transfer_control;
         let mut report_state = false;
         for event in events {
             match event {

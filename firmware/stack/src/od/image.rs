@@ -262,6 +262,7 @@ pub fn load(image: &mut [u8], spans: &[Span], area: super::Area, source: &mut dy
 }
 
 /// Bytes of the persistent block `spans` describe.
+#[allow(clippy::indexing_slicing)] // Const code: `i < spans.len()`.
 pub const fn block_len(spans: &[Span]) -> usize {
     let (mut i, mut n) = (0, 0);
     while i < spans.len() {
