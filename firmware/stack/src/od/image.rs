@@ -59,13 +59,22 @@ pub fn write(image: &mut [u8], info: &EntryInfo, sub: u8, data: &[u8]) -> Result
         (DataType::Boolean, [b]) => *b = u8::from(data.iter().any(|&d| d != 0)),
         _ if info.is_variable_length() => {
             let (len, rest) = slot.split_at_mut_checked(LEN_BYTES).ok_or(SdoAbort::NoSubIndex)?;
-            let dst = rest.get_mut(..data.len()).ok_or(SdoAbort::LengthTooHigh)?;
-            dst.copy_from_slice(data);
-            len.copy_from_slice(&u16::try_from(data.len()).map_err(|_| SdoAbort::LengthTooHigh)?.to_le_bytes());
+            let count = u16::try_from(data.len()).map_err(|_| SdoAbort::LengthTooHigh)?;
+            put(rest.get_mut(..data.len()).ok_or(SdoAbort::LengthTooHigh)?, data);
+            put(len, &count.to_le_bytes());
         }
-        _ => slot.get_mut(..data.len()).ok_or(SdoAbort::LengthTooHigh)?.copy_from_slice(data),
+        _ => put(slot.get_mut(..data.len()).ok_or(SdoAbort::LengthTooHigh)?, data),
     }
     Ok(())
+}
+
+/// `dst` := `src` (of the same length), byte by byte: a loop as long as the data, which Kani
+/// unrolls over the few bytes a write brings, where a slice copy of symbolic length into the
+/// whole image made its formula too large to solve.
+fn put(dst: &mut [u8], src: &[u8]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        *d = *s;
+    }
 }
 
 /// A contiguous piece of the image that belongs to one index class: the unit of resets
