@@ -840,23 +840,67 @@ pub fn check_double_corruption<'p, const N: usize, const BLOCKS: usize, const BL
     values: [u8; 2],
     via: Detect,
 ) -> (Banks<'p, N, BLOCKS, BLOCK>, DoubleOutcome) {
-    assert_geometry::<N, BLOCKS, BLOCK>();
     let block = block % BLOCKS;
-    let before = images(&banks);
+    let (before, applied) = corrupt_both::<N, BLOCKS, BLOCK>(banks.banks_mut(), block, offsets, values);
+    let corrupted = images(&banks);
+    let (banks, found) = detect(banks, block, via);
+    double_outcome(banks, block, &before, &corrupted, applied, found, via)
+}
+
+/// The reboot case of [`check_double_corruption`] on banks that are powered off: the
+/// corruption is made in the EEPROMs and found by the first mount. Banks that agree mount
+/// without a write and with a clean state (`prop_recovery_idempotent`), so this is the same
+/// as mounting them, corrupting them and rebooting, with one mount of symbolic banks fewer
+/// for Kani.
+pub fn check_double_corruption_at_boot<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    mut devices: [CutEeprom<'p, N>; 2],
+    block: usize,
+    offsets: [usize; 2],
+    values: [u8; 2],
+) -> (Banks<'p, N, BLOCKS, BLOCK>, DoubleOutcome) {
+    let block = block % BLOCKS;
+    let (before, applied) = corrupt_both::<N, BLOCKS, BLOCK>(&mut devices, block, offsets, values);
+    let corrupted = [*devices[0].as_bytes(), *devices[1].as_bytes()];
+    let banks = Banks::mount(devices);
+    double_outcome(banks, block, &before, &corrupted, applied, None, Detect::Mount)
+}
+
+/// Sets byte `offsets[i]` of `block`'s slot in bank `i` to `values[i]` in banks that agree;
+/// returns the images from before and whether both values differed from the stored bytes.
+fn corrupt_both<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    devices: &mut [CutEeprom<'_, N>; 2],
+    block: usize,
+    offsets: [usize; 2],
+    values: [u8; 2],
+) -> ([[u8; N]; 2], bool) {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    let before = [*devices[0].as_bytes(), *devices[1].as_bytes()];
     assert!(before[0] == before[1], "precondition: settled banks");
+    let mut applied = true;
+    for (bank, device) in devices.iter_mut().enumerate() {
+        let (offset, value) = (offsets[bank], values[bank]);
+        let pos = block * slot_size(BLOCK) + offset % slot_size(BLOCK);
+        applied &= before[bank][pos] != value;
+        device.as_bytes_mut()[pos] = value;
+    }
+    (before, applied)
+}
+
+/// After a double corruption of `block` was looked for (`found`: what a first read of it
+/// returned): reads every byte of the block, checks the others and restarts it with a write.
+fn double_outcome<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    mut banks: Banks<'p, N, BLOCKS, BLOCK>,
+    block: usize,
+    before: &[[u8; N]; 2],
+    corrupted: &[[u8; N]; 2],
+    applied: bool,
+    found: Option<Result<[u8; BLOCK], Error>>,
+    via: Detect,
+) -> (Banks<'p, N, BLOCKS, BLOCK>, DoubleOutcome) {
     let mut expected = [[0; BLOCK]; BLOCKS];
     for (b, e) in expected.iter_mut().enumerate() {
         e.copy_from_slice(slot::<BLOCK>(&before[0], b).get(..BLOCK).unwrap_or(&[0; BLOCK]));
     }
-    let mut applied = true;
-    for bank in 0..2 {
-        let (offset, value) = (offsets[bank], values[bank]);
-        let pos = block * slot_size(BLOCK) + offset % slot_size(BLOCK);
-        applied &= before[bank][pos] != value;
-        banks.banks_mut()[bank].as_bytes_mut()[pos] = value;
-    }
-    let corrupted = images(&banks);
-    let (mut banks, found) = detect(banks, block, via);
     let lost = Err(Error::Lost { block });
     let held = |bank: usize, data: &[u8; BLOCK]| slot::<BLOCK>(&corrupted[bank], block).get(..BLOCK) == Some(data);
     let read_agreed = match found {
@@ -903,6 +947,18 @@ pub fn prop_double_corruption<'p, const N: usize, const BLOCKS: usize, const BLO
 ) -> Banks<'p, N, BLOCKS, BLOCK> {
     let (banks, out) = check_double_corruption(banks, block, offsets, values, via);
     assert!(out.is_clean(), "block {block} corrupted at {offsets:?} := {values:?} via {via:?}: {out:?}");
+    banks
+}
+
+/// [`prop_double_corruption`] by a reboot of banks corrupted while powered off.
+pub fn prop_double_corruption_at_boot<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    devices: [CutEeprom<'p, N>; 2],
+    block: usize,
+    offsets: [usize; 2],
+    values: [u8; 2],
+) -> Banks<'p, N, BLOCKS, BLOCK> {
+    let (banks, out) = check_double_corruption_at_boot(devices, block, offsets, values);
+    assert!(out.is_clean(), "block {block} corrupted at {offsets:?} := {values:?} at boot: {out:?}");
     banks
 }
 

@@ -130,6 +130,18 @@ proptest! {
     }
 
     #[test]
+    fn banks_double_corruption_before_the_first_mount_is_lost(data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), block in 0..2_usize, offsets in any::<[usize; 2]>(), flips in any::<[u8; 2]>()) {
+        use coforge_verification::banks::*;
+        prop_assume!(data[block] != [0; 8] || seqs[block] != 0);
+        prop_assume!(flips[0] != 0 && flips[1] != 0);
+        let power = Power::new();
+        let devices = committed_devices::<24, 2, 8>(&power, &data, &seqs);
+        let offsets = offsets.map(|o| o % 12);
+        let values = [0, 1].map(|b| devices[b].as_bytes()[block * 12 + offsets[b]] ^ flips[b]);
+        prop_double_corruption_at_boot::<24, 2, 8>(devices, block, offsets, values);
+    }
+
+    #[test]
     fn banks_checksum_matches_after_operations(kind in any::<u8>(), data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), random in any::<[[u8; 24]; 2]>(), mutations in banks_small::mutations(), ops in proptest::collection::vec(any::<[u8; 6]>(), 0..16)) {
         use coforge_verification::banks::*;
         let power = Power::new();
