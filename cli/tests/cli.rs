@@ -15,10 +15,11 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("coforge-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+/// A path for `name` in a scratch directory of its own, removed when the returned guard drops.
+fn scratch(name: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::Builder::new().prefix("coforge-cli-").tempdir().expect("temp dir");
+    let path = dir.path().join(name);
+    (dir, path)
 }
 
 #[test]
@@ -54,7 +55,7 @@ fn eds_needs_a_mode_for_devices_with_modes_and_writes_the_file() {
     let o = coforge(&["eds", "spec/co401gw1.yaml"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("choose one with --mode"), "{}", stderr(&o));
-    let out = scratch("gw1.eds");
+    let (_dir, out) = scratch("gw1.eds");
     let o = coforge(&["eds", "spec/co401gw1.yaml", "--mode", "mixed", "-o", out.to_str().unwrap_or_default()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let eds = std::fs::read_to_string(&out).unwrap_or_default();
@@ -72,7 +73,7 @@ fn docs_render_the_object_dictionary() {
 #[test]
 fn fmt_check_reports_and_fmt_repairs_layout() {
     let original = std::fs::read_to_string(repo().join("spec/cr3101.yaml")).unwrap_or_default();
-    let messy = scratch("messy.yaml");
+    let (_dir, messy) = scratch("messy.yaml");
     // Same data, different layout: no blank lines between sections, extra spaces after dashes.
     let lines: Vec<&str> = original.lines().collect();
     let messy_text: Vec<String> = lines
@@ -109,7 +110,7 @@ fn decode_names_the_command_and_its_fields() {
 
 #[test]
 fn beds_reproduces_the_vendors_file_from_its_eds() {
-    let out = scratch("io.bin");
+    let (_dir, out) = scratch("io.bin");
     let eds = "tests/vendor-data/canopenia/CiA401_IO_Node3.eds";
     // The vendor's tool ran on 02-11-2015; the stamp is not in the EDS, so it is given.
     let ident = "'CiA401_IO_Node3' 02-11-2015 12:43PM by ESAcademy";
@@ -135,7 +136,7 @@ fn beds_reproduces_the_vendors_file_from_its_eds() {
 
 #[test]
 fn beds_exports_a_spec_and_explains_bad_arguments() {
-    let out = scratch("ia.bin");
+    let (_dir, out) = scratch("ia.bin");
     let o = coforge(&["beds", "spec/canopenia.yaml", "--node-id", "5", "--bitrate", "250", "-o", out.to_str().expect("utf-8 path")]);
     assert!(o.status.success(), "{}", stderr(&o));
     let bytes = std::fs::read(&out).expect("written");

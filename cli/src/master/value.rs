@@ -199,15 +199,13 @@ mod tests {
 
     #[test]
     fn eds_data_types() {
-        let dir = std::env::temp_dir().join(format!("coforge-master-eds-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("a temporary directory");
-        let path = dir.join("t.eds");
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let path = dir.path().join("t.eds");
         std::fs::write(&path, "[1000]\nParameterName=Device type\nDataType=0x0007\n[1018]\nSubNumber=5\n[1018sub1]\nDataType=0x0007\n[1008]\nDataType=0x0009\n[2000sub3]\nDataType=0x0020\n").expect("a temporary EDS");
         assert_eq!(from_eds(&path, 0x1000, 0), Ok(Type::U32));
         assert_eq!(from_eds(&path, 0x1018, 1), Ok(Type::U32));
         assert_eq!(from_eds(&path, 0x1008, 0), Ok(Type::Str));
         assert!(from_eds(&path, 0x1018, 2).is_err_and(|e| e.contains("no entry 1018h sub 2")));
         assert!(from_eds(&path, 0x2000, 3).is_err_and(|e| e.contains("0x0020")));
-        std::fs::remove_dir_all(&dir).expect("the temporary directory removed");
     }
 }

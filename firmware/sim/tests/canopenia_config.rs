@@ -7,7 +7,6 @@
 use coforge_sim::devices::{DeviceKind, StoreAt};
 use coforge_sim::vbus::VirtualBus;
 use coforge_stack::frame::CanFrame;
-use std::path::PathBuf;
 
 const FIRMWARE_ID: u8 = 2;
 const BOOTLOADER: u8 = 0x70;
@@ -28,16 +27,16 @@ struct Bench {
     store: StoreAt,
     /// Every frame on the bus not taken by [`Bench::frames`] yet.
     seen: Vec<CanFrame>,
+    /// Holds the memory files; removed when the bench is dropped.
+    _dir: tempfile::TempDir,
 }
 
 impl Bench {
     /// The coprocessor (runtime node-ID 2) with its memories in files under a fresh directory.
     fn new(name: &str) -> Self {
-        let dir: PathBuf = std::env::temp_dir().join(format!("coforge-ia-config-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        let store = StoreAt::File(dir.join("ia"));
-        let mut bench = Bench { bus: VirtualBus::new(Vec::new()), store, seen: Vec::new() };
+        let dir = tempfile::Builder::new().prefix(&format!("coforge-ia-config-{name}-")).tempdir().unwrap();
+        let store = StoreAt::File(dir.path().join("ia"));
+        let mut bench = Bench { bus: VirtualBus::new(Vec::new()), store, seen: Vec::new(), _dir: dir };
         bench.power_on();
         bench
     }

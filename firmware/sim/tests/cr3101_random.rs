@@ -47,7 +47,7 @@ fn data(rng: &mut fastrand::Rng) -> Vec<u8> {
 
 fn run(seed: u64) {
     let path = image(&format!("random-{seed}"));
-    let mut d = SimCr3101::new(SimBoard::new(Some(path.clone())).unwrap(), BlockStore::new(Eeprom::new(4096), 0), NODE);
+    let mut d = SimCr3101::new(SimBoard::new(Some(path.to_path_buf())).unwrap(), BlockStore::new(Eeprom::new(4096), 0), NODE);
     let mut rng = fastrand::Rng::with_seed(seed);
     let mut now = 0_u64;
     d.start(now);

@@ -54,8 +54,8 @@ fn the_serial_host_and_the_console_reach_the_running_module() {
 
 #[test]
 fn banks_kept_in_files_survive_a_restart_of_the_simulated_module() {
-    let dir = std::env::temp_dir().join(format!("coforge-memory1-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
     let store = StoreAt::File(dir.join("banks"));
     let kind = DeviceKind::find("co401memory1").unwrap();
     let mut node = kind.create(None, 3, &store).unwrap();
@@ -70,5 +70,4 @@ fn banks_kept_in_files_survive_a_restart_of_the_simulated_module() {
     assert_eq!(value, [0x5A]);
     node.node_mut().read(0x6000, 1, 0, &mut value, Side::Device).unwrap();
     assert_eq!(value, [0], "a clean restart reports nothing");
-    std::fs::remove_dir_all(&dir).unwrap();
 }

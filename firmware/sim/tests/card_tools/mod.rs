@@ -8,14 +8,33 @@ use std::process::Command;
 
 pub const MIB: u64 = 1 << 20;
 
+/// A card image file in a scratch directory that is removed when the test ends, pass or fail
+/// (16 MiB per card, dozens of cards per run: leaving them would fill the disk).
+pub struct Card {
+    path: PathBuf,
+    _dir: tempfile::TempDir,
+}
+
+impl std::ops::Deref for Card {
+    type Target = Path;
+
+    fn deref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl AsRef<Path> for Card {
+    fn as_ref(&self) -> &Path {
+        &self.path
+    }
+}
+
 /// A new 16 MiB card image in a directory of its own, named after the test.
-pub fn image(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("coforge-card-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("card.img");
+pub fn image(name: &str) -> Card {
+    let dir = tempfile::Builder::new().prefix(&format!("coforge-card-{name}-")).tempdir().unwrap();
+    let path = dir.path().join("card.img");
     CardImage::create(&path, 16 * MIB, "CANMEM").unwrap();
-    path
+    Card { path, _dir: dir }
 }
 
 /// mtools on the card's first partition (it starts at 1 MiB).
