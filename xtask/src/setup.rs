@@ -57,6 +57,31 @@ fn apt_install(packages: &[&str], why: &str) -> Result {
     run(&mut install)
 }
 
+/// Free space on the file system that holds `target/`, from `df` (std has no portable call).
+fn free_gib() -> Option<f64> {
+    available_gib(&output(Command::new("df").args(["-Pk"]).arg(root()))?)
+}
+
+/// The "Available" column of `df -Pk` (POSIX format: a header, then one line), in GiB.
+fn available_gib(df: &str) -> Option<f64> {
+    let kib: f64 = df.lines().nth(1)?.split_whitespace().nth(3)?.parse().ok()?;
+    Some(kib / (1024.0 * 1024.0))
+}
+
+/// Says how much disk the run has before it starts: a full test run from a clean clone
+/// writes about `needed_gib` GiB (build directories, card images, fuzz corpora), and a disk
+/// that fills up surfaces as a linker "Bus error" minutes in, not as a clear message.
+pub fn disk_space(needed_gib: f64) {
+    match free_gib() {
+        Some(free) if free < needed_gib => println!(
+            "xtask: warning: {free:.1} GiB free for {}; a run from a clean clone writes about {needed_gib:.0} GiB and may fail with \"No space left on device\" (builds already in target/ need less)",
+            root().display()
+        ),
+        Some(free) => println!("xtask: {free:.1} GiB free for the build (a clean clone needs about {needed_gib:.0} GiB)"),
+        None => println!("xtask: could not read the free disk space (`df` missing); a clean clone needs about {needed_gib:.0} GiB"),
+    }
+}
+
 /// valgrind, whose callgrind counts the x86-64 instructions of the manager benchmark.
 pub fn valgrind() -> Result {
     if output(Command::new("valgrind").arg("--version")).is_none() {
@@ -120,4 +145,17 @@ pub fn fuzz_tools() -> Result {
         run(Command::new("cargo").args(["install", "cargo-fuzz", "--locked"]))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn free_space_is_read_from_posix_df_output() {
+        let df = "Filesystem     1024-blocks      Used Available Capacity Mounted on\n/dev/vda        263174212 40123456  56623104      42% /\n";
+        assert_eq!(available_gib(df), Some(54.0));
+        assert_eq!(available_gib("Filesystem 1024-blocks Used Available Capacity Mounted on\n"), None);
+        assert_eq!(available_gib("header\n/dev/vda 1 2 lots 4% /\n"), None);
+    }
 }
