@@ -175,6 +175,28 @@ mod mirrored_banks {
         prop_recovery_idempotent::<N, BLOCKS, BLOCK>(any_devices(&power));
     }
 
+    /// (b), first half of the above: any contents mounted once are left settled, not to be
+    /// formatted, with lost flags and status to match (`prop_first_mount_settles`).
+    #[kani::proof]
+    #[kani::unwind(13)]
+    #[kani::solver(kissat)]
+    fn banks_first_mount_settles_any_contents() {
+        let power = Power::new();
+        prop_first_mount_settles::<N, BLOCKS, BLOCK>(any_devices(&power));
+    }
+
+    /// (b), second half: any settled banks that a mount does not format mount without a write
+    /// or a change, and read back what they hold (`prop_settled_mount_is_quiet`).
+    #[kani::proof]
+    #[kani::unwind(13)]
+    #[kani::solver(kissat)]
+    fn banks_settled_banks_mount_quietly() {
+        let power = Power::new();
+        let images: [[u8; N]; 2] = kani::any();
+        kani::assume(is_settled::<N, BLOCKS, BLOCK>(&images) && !settled_mount_formats::<N, BLOCKS, BLOCK>(&images));
+        prop_settled_mount_is_quiet::<N, BLOCKS, BLOCK>([CutEeprom::new(&power, images[0]), CutEeprom::new(&power, images[1])]);
+    }
+
     /// (b) Any contents, the recovery cut at any byte write with any byte left: the reboot
     /// ends with the contents and images of an uncut recovery.
     #[kani::proof]

@@ -48,6 +48,7 @@ proptest! {
 /// blocks of 2 bytes, which `tests/banks_model.rs` searches exhaustively), with structured contents: committed banks, erased or random ones, then a few bytes
 /// of either bank overwritten.
 mod banks_small {
+    use coforge_storage::record::Record;
     use coforge_verification::banks::*;
     use proptest::prelude::*;
 
@@ -75,6 +76,59 @@ mod banks_small {
         d
     }
 
+    /// Settled banks, block by block after `kinds` (mod 5): any data committed with any
+    /// sequence number; zeros committed as sequence 0 (what a format writes); lost with
+    /// garbage in both copies; lost with both copies staged by a format cut (bank `open` (mod 3)
+    /// open: 1, 2 or both); lost with a staged copy and a garbage one.
+    pub fn settled(kinds: &[u8; 2], data: &[[u8; 8]; 2], seqs: &[u8; 2], garbage: &[[u8; 12]; 2], open: &[u8; 2]) -> [[u8; 24]; 2] {
+        let mut images = [[0_u8; 24]; 2];
+        for block in 0..2 {
+            let zeros = Record::committed(&[0; 8], 0);
+            let staged = |mark: u8| Record { begin: mark, ..zeros }.to_bytes();
+            let copies: [[u8; 12]; 2] = match kinds[block] % 5 {
+                0 => [committed_slot(&data[block], seqs[block]); 2],
+                1 => [committed_slot(&[0; 8], 0); 2],
+                2 => garbage_slots(garbage),
+                kind => {
+                    // An open copy's begin is the format's mark (any value but the end, 0).
+                    let mark = seqs[block] | 1;
+                    let which = open[block] % 3;
+                    let mut copies = [[0_u8; 12]; 2];
+                    for (bank, copy) in copies.iter_mut().enumerate() {
+                        // A closed staged copy keeps an older sequence number in both markers
+                        // (not 0: that would be the formatted copy itself, valid).
+                        let record =
+                            if which == 2 || usize::from(which) == bank { staged(mark) } else { Record { begin: mark, end: mark, ..zeros }.to_bytes() };
+                        copy[8..].copy_from_slice(&record);
+                    }
+                    if kind == 4 {
+                        copies[1] = garbage_slots(garbage)[1];
+                    }
+                    copies
+                }
+            };
+            for (image, copy) in images.iter_mut().zip(copies) {
+                image[block * 12..block * 12 + 12].copy_from_slice(&copy);
+            }
+        }
+        images
+    }
+
+    fn committed_slot(data: &[u8; 8], seq: u8) -> [u8; 12] {
+        let mut slot = [0; 12];
+        slot[..8].copy_from_slice(data);
+        slot[8..].copy_from_slice(&Record::committed(data, seq).to_bytes());
+        slot
+    }
+
+    /// Two invalid copies: any bytes, with `end` made to differ from `begin`.
+    fn garbage_slots(garbage: &[[u8; 12]; 2]) -> [[u8; 12]; 2] {
+        garbage.map(|mut g| {
+            g[11] = g[8].wrapping_add(1);
+            g
+        })
+    }
+
     pub fn mutations() -> impl Strategy<Value = Vec<(usize, usize, u8)>> {
         proptest::collection::vec((0..2_usize, 0..24_usize, any::<u8>()), 0..5)
     }
@@ -98,7 +152,26 @@ proptest! {
     fn banks_recovery_is_idempotent(kind in any::<u8>(), data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), random in any::<[[u8; 24]; 2]>(), mutations in banks_small::mutations()) {
         use coforge_verification::banks::*;
         let power = Power::new();
-        prop_recovery_idempotent::<24, 2, 8>(banks_small::devices(&power, kind, &data, &seqs, &random, &mutations));
+        let devices = banks_small::devices(&power, kind, &data, &seqs, &random, &mutations);
+        let after = prop_first_mount_settles::<24, 2, 8>(devices.clone());
+        prop_settled_mount_is_quiet::<24, 2, 8>([CutEeprom::new(&power, after[0]), CutEeprom::new(&power, after[1])]);
+        prop_recovery_idempotent::<24, 2, 8>(devices);
+    }
+
+    /// `settled_mount_formats`, the specification the second half of idempotence assumes, says
+    /// exactly when the firmware formats settled banks; those it does not format mount quietly.
+    #[test]
+    fn settled_banks_format_exactly_when_the_rule_says(kinds in any::<[u8; 2]>(), data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), garbage in any::<[[u8; 12]; 2]>(), open in any::<[u8; 2]>()) {
+        use coforge_verification::banks::*;
+        let power = Power::new();
+        let images = banks_small::settled(&kinds, &data, &seqs, &garbage, &open);
+        prop_assert!(is_settled::<24, 2, 8>(&images));
+        let formats = settled_mount_formats::<24, 2, 8>(&images);
+        let banks = Banks::<24, 2, 8>::mount([CutEeprom::new(&power, images[0]), CutEeprom::new(&power, images[1])]);
+        prop_assert_eq!(writes(&banks) > 0, formats, "kinds {:?}", kinds);
+        if !formats {
+            prop_settled_mount_is_quiet::<24, 2, 8>([CutEeprom::new(&power, images[0]), CutEeprom::new(&power, images[1])]);
+        }
     }
 
     #[test]
