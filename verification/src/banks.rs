@@ -577,28 +577,35 @@ pub struct Recovery {
     pub lost: usize,
 }
 
-/// Mounting any bank contents twice: the second mount writes nothing, finds nothing new and
-/// leaves contents and images unchanged; after the first, every block is lost or identical
-/// and valid in both banks. Banks that already agree (identical images, every block valid)
-/// are mounted without a single write or status bit.
-pub fn prop_recovery_idempotent<const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut devices: [CutEeprom<'_, N>; 2]) -> Recovery {
+/// Mounts any bank contents with the power on and the access counts reset. Banks that agree
+/// (identical images, every block valid) are mounted without a single write or status bit.
+fn first_mount<const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut devices: [CutEeprom<'_, N>; 2]) -> Banks<'_, N, BLOCKS, BLOCK> {
     assert_geometry::<N, BLOCKS, BLOCK>();
     devices[0].power().restore_power();
     let agreeing = devices[0].as_bytes() == devices[1].as_bytes() && (0..BLOCKS).all(|b| copy_is_valid::<BLOCK>(devices[0].as_bytes(), b));
     for d in &mut devices {
         d.reset_counts();
     }
-    let mut first = Banks::<N, BLOCKS, BLOCK>::mount(devices);
+    let first = Banks::<N, BLOCKS, BLOCK>::mount(devices);
+    if agreeing {
+        assert_eq!(writes(&first), 0, "banks that agree are mounted without writes");
+        assert_eq!([first.status(0), first.status(1)], [BankStatus::default(); 2], "banks that agree are mounted without status bits");
+    }
+    first
+}
+
+/// Mounting any bank contents twice: the second mount writes nothing, finds nothing new and
+/// leaves contents and images unchanged; after the first, every block is lost or identical
+/// and valid in both banks. Banks that already agree (identical images, every block valid)
+/// are mounted without a single write or status bit.
+pub fn prop_recovery_idempotent<const N: usize, const BLOCKS: usize, const BLOCK: usize>(devices: [CutEeprom<'_, N>; 2]) -> Recovery {
+    let mut first = first_mount::<N, BLOCKS, BLOCK>(devices);
     let recovery = Recovery {
         repair_writes: writes(&first),
         reads: reads(&first),
         status: [first.status(0), first.status(1)],
         lost: (0..BLOCKS).filter(|&b| first.is_lost(b)).count(),
     };
-    if agreeing {
-        assert_eq!(recovery.repair_writes, 0, "banks that agree are mounted without writes");
-        assert_eq!(recovery.status, [BankStatus::default(); 2], "banks that agree are mounted without status bits");
-    }
     let after_first = images(&first);
     for block in 0..BLOCKS {
         let valid = copy_is_valid::<BLOCK>(&after_first[0], block);
@@ -670,19 +677,9 @@ pub fn settled_mount_formats<const N: usize, const BLOCKS: usize, const BLOCK: u
 /// its lost flags are exactly the blocks with no valid copy, and a lost block shows
 /// `CHECKSUM_ERROR` in both banks. Banks that agree are mounted without a write or a status
 /// bit. Returns the images it left.
-pub fn prop_first_mount_settles<const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut devices: [CutEeprom<'_, N>; 2]) -> [[u8; N]; 2] {
-    assert_geometry::<N, BLOCKS, BLOCK>();
-    devices[0].power().restore_power();
-    let agreeing = devices[0].as_bytes() == devices[1].as_bytes() && (0..BLOCKS).all(|b| copy_is_valid::<BLOCK>(devices[0].as_bytes(), b));
-    for d in &mut devices {
-        d.reset_counts();
-    }
-    let first = Banks::<N, BLOCKS, BLOCK>::mount(devices);
+pub fn prop_first_mount_settles<const N: usize, const BLOCKS: usize, const BLOCK: usize>(devices: [CutEeprom<'_, N>; 2]) -> [[u8; N]; 2] {
+    let first = first_mount::<N, BLOCKS, BLOCK>(devices);
     let status = [first.status(0), first.status(1)];
-    if agreeing {
-        assert_eq!(writes(&first), 0, "banks that agree are mounted without writes");
-        assert_eq!(status, [BankStatus::default(); 2], "banks that agree are mounted without status bits");
-    }
     let after = images(&first);
     assert!(is_settled::<N, BLOCKS, BLOCK>(&after), "every block is lost or settled");
     for block in 0..BLOCKS {
