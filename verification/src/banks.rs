@@ -1162,20 +1162,33 @@ fn pattern(len: usize, value: u8, step: u8) -> [u8; MAX_OP_LEN] {
     data
 }
 
+/// A write of `len` bytes of `pattern(value, 1)` at `addr` with the power cut at byte write
+/// `cut_at`, leaving `cut`; the power is back afterwards, before any reboot.
+pub fn cut_write<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    banks: &mut Banks<'_, N, BLOCKS, BLOCK>,
+    addr: usize,
+    len: usize,
+    value: u8,
+    cut_at: u32,
+    cut: CutByte,
+) {
+    let power = banks.banks()[0].power();
+    let data = pattern(len, value, 1);
+    power.arm(cut_at, cut);
+    let _ = banks.write(addr, data.get(..len).unwrap_or(&[]));
+    power.restore_power();
+}
+
 /// Runs `op` on the banks (no assertion: [`prop_checksum_after_ops`] and [`prop_banks_total`]
 /// say what must hold after it).
 pub fn apply<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut banks: Banks<'p, N, BLOCKS, BLOCK>, op: Op) -> Banks<'p, N, BLOCKS, BLOCK> {
-    let power = banks.banks()[0].power();
     match op {
         Op::Write { addr, len, value, step } => {
             let data = pattern(len, value, step);
             let _ = banks.write(addr, data.get(..len).unwrap_or(&[]));
         }
         Op::CutWrite { addr, len, value, cut_at, cut } => {
-            let data = pattern(len, value, 1);
-            power.arm(cut_at, cut);
-            let _ = banks.write(addr, data.get(..len).unwrap_or(&[]));
-            power.restore_power();
+            cut_write(&mut banks, addr, len, value, cut_at, cut);
             return Banks::mount(banks.into_banks());
         }
         Op::Corrupt { bank, pos, value } => {
@@ -1213,11 +1226,8 @@ pub fn prop_checksum_after_ops<const N: usize, const BLOCKS: usize, const BLOCK:
         let op = Op::decode::<N, BLOCKS, BLOCK>(bytes);
         if let Op::CutWrite { addr, len, value, cut_at, cut } = op {
             // The sums right after the cut, before the reboot.
-            let data = pattern(len, value, 1);
-            power.arm(cut_at, cut);
-            let _ = banks.write(addr, data.get(..len).unwrap_or(&[]));
+            cut_write(&mut banks, addr, len, value, cut_at, cut);
             assert_eq!(checksum_errors(&banks), 0, "right after operation {i} {op:?}");
-            power.restore_power();
             banks = Banks::mount(banks.into_banks());
         } else {
             banks = apply(banks, op);
@@ -1238,13 +1248,7 @@ pub fn prop_banks_total<const N: usize, const BLOCKS: usize, const BLOCK: usize>
     }
     let mut banks = Banks::<N, BLOCKS, BLOCK>::mount(devices);
     let both = unreadable == [false, false];
-    for block in 0..BLOCKS {
-        let [a, b] = images(&banks);
-        let settled = copy_is_valid::<BLOCK>(&a, block) && slot::<BLOCK>(&a, block) == slot::<BLOCK>(&b, block);
-        assert!(!both || banks.is_lost(block) || settled, "block {block} neither lost nor settled");
-        let read = banks.read(block * BLOCK, &mut [0; BLOCK]);
-        assert_eq!(read.is_ok(), !banks.is_lost(block), "block {block}: {read:?}");
-    }
+    check_mounted(&mut banks, both);
     if !both && BLOCKS * BLOCK > 0 {
         assert_eq!(banks.write(0, &[0]), Err(Error::Access), "no write while a bank does not answer");
     }
@@ -1253,6 +1257,83 @@ pub fn prop_banks_total<const N: usize, const BLOCKS: usize, const BLOCK: usize>
         // Out-of-range queries answer too.
         let _ = (banks.status(2), banks.checksum(2), banks.is_lost(BLOCKS));
         banks.clear_status(2);
+    }
+}
+
+/// Right after a mount: every block is lost or identical and valid in both banks (when `both`
+/// answer), and a read of each block succeeds exactly when it is not lost.
+fn check_mounted<const N: usize, const BLOCKS: usize, const BLOCK: usize>(banks: &mut Banks<'_, N, BLOCKS, BLOCK>, both: bool) {
+    for block in 0..BLOCKS {
+        let [a, b] = images(banks);
+        let settled = copy_is_valid::<BLOCK>(&a, block) && slot::<BLOCK>(&a, block) == slot::<BLOCK>(&b, block);
+        assert!(!both || banks.is_lost(block) || settled, "block {block} neither lost nor settled");
+        let read = banks.read(block * BLOCK, &mut [0; BLOCK]);
+        assert_eq!(read.is_ok(), !banks.is_lost(block), "block {block}: {read:?}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// (d) One operation at a time, from any state a running device can hold.
+//
+// `prop_checksum_after_ops` and `prop_banks_total` run sequences of operations; Kani cannot
+// take many symbolic operations in a row (each may be a reboot, a mount of symbolic banks).
+// `prop_step` takes one operation from any running state instead: a state built by
+// `MirroredBanks::in_state` with any images, status, lost flags and scrub position, and the
+// per-block sums equal to the images'. Nothing panics, and the sums stay right; a reboot
+// (`Op::Reboot`, a mount that ignores the state before it) leaves them right from any
+// contents. By induction both properties then hold for any number of operations, not only
+// for the bounded sequences of the sequence properties.
+
+/// Banks in any running state: `devices` hold any images, a bank answers nothing when
+/// `unreadable` says so, and `status`, `lost` and `scrub_at` are anything; each block's sum
+/// equals its data bytes in that image, the invariant [`prop_step`] carries forward.
+pub fn running_banks<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    mut devices: [CutEeprom<'p, N>; 2],
+    unreadable: [bool; 2],
+    status: [u8; 2],
+    lost: [bool; BLOCKS],
+    scrub_at: usize,
+) -> Banks<'p, N, BLOCKS, BLOCK> {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    devices[0].power().restore_power();
+    let mut sums = [[0_u16; BLOCKS]; 2];
+    for (bank, d) in devices.iter_mut().enumerate() {
+        for (block, sum) in sums[bank].iter_mut().enumerate() {
+            for &b in &slot::<BLOCK>(d.as_bytes(), block)[..BLOCK] {
+                *sum = sum.wrapping_add(u16::from(b));
+            }
+        }
+        d.set_unreadable(unreadable[bank]);
+    }
+    Banks::in_state(devices, [BankStatus(status[0]), BankStatus(status[1])], sums, lost, scrub_at)
+}
+
+/// One operation on `banks` (a [`running_banks`] state whose banks answer unless
+/// `unreadable` says otherwise): nothing panics; while both banks answer, the bank sums still
+/// equal a recomputation afterwards; while one does not, a write changes no byte of either
+/// bank. A cut write is taken up to the cut, with the power back ([`cut_write`]); the reboot
+/// after it is an [`Op::Reboot`] step, which also checks what [`prop_banks_total`] checks
+/// after its mount.
+pub fn prop_step<const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut banks: Banks<'_, N, BLOCKS, BLOCK>, unreadable: [bool; 2], op: Op) {
+    let both = unreadable == [false, false];
+    assert_eq!(checksum_errors(&banks), 0, "precondition: the sums are right");
+    let before = images(&banks);
+    let banks = match op {
+        Op::CutWrite { addr, len, value, cut_at, cut } => {
+            cut_write(&mut banks, addr, len, value, cut_at, cut);
+            banks
+        }
+        Op::Reboot => {
+            let mut banks = apply(banks, op);
+            check_mounted(&mut banks, both);
+            banks
+        }
+        op => apply(banks, op),
+    };
+    if both {
+        assert_eq!(checksum_errors(&banks), 0, "after {op:?}");
+    } else if matches!(op, Op::Write { .. } | Op::CutWrite { .. }) {
+        assert!(same_images(&images(&banks), &before), "{op:?} changed a byte while a bank does not answer");
     }
 }
 

@@ -227,4 +227,16 @@ proptest! {
         let power = Power::new();
         prop_banks_total::<24, 2, 8>(banks_small::devices(&power, kind, &data, &seqs, &random, &mutations), unreadable, &ops);
     }
+
+    /// One operation from any running state (any images, status, lost flags, scrub position;
+    /// either bank silent): what the Kani step harnesses prove. Both banks answer in 3 of 4
+    /// cases, so the sums half is well exercised.
+    #[test]
+    fn banks_step_from_any_running_state(kind in any::<u8>(), data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), random in any::<[[u8; 24]; 2]>(), mutations in banks_small::mutations(), silent in any::<u8>(), status in any::<[u8; 2]>(), lost in any::<[bool; 2]>(), scrub_at in 0..2_usize, op in any::<[u8; 6]>()) {
+        use coforge_verification::banks::*;
+        let power = Power::new();
+        let unreadable = [silent % 8 == 1, silent % 8 == 2];
+        let banks = running_banks::<24, 2, 8>(banks_small::devices(&power, kind, &data, &seqs, &random, &mutations), unreadable, status, lost, scrub_at);
+        prop_step(banks, unreadable, Op::decode::<24, 2, 8>(op));
+    }
 }

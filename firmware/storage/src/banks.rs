@@ -108,6 +108,14 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
         me
     }
 
+    /// Banks in any state a running device can hold, without a mount: any devices, status,
+    /// per-block sums, lost flags and scrub position. For proofs that go one operation at a
+    /// time from any state (`coforge-verification`); a device always starts with [`Self::mount`].
+    #[cfg(feature = "proof-states")]
+    pub fn in_state(banks: [S; 2], status: [BankStatus; 2], block_sums: [[u16; BLOCKS]; 2], lost: [bool; BLOCKS], scrub_at: usize) -> Self {
+        MirroredBanks { banks, status, block_sums, lost, scrub_at }
+    }
+
     /// Writes zeros, committed as sequence 0, to both banks of every lost block (in blank
     /// banks the others are formatted already, or were just repaired from a formatted copy).
     /// Two phases, so that a power cut leaves banks the next mount formats again: first every
