@@ -391,12 +391,18 @@ pub fn mount_agreeing<'p, const N: usize, const BLOCKS: usize, const BLOCK: usiz
     {
         let built = running_banks::<N, BLOCKS, BLOCK>(devices.clone(), [false; 2], [0; 2], [false; BLOCKS], 0);
         let mounted = Banks::<N, BLOCKS, BLOCK>::mount(devices);
-        let observed = |b: &Banks<'_, N, BLOCKS, BLOCK>| {
-            (images(b), [b.status(0), b.status(1)], core::array::from_fn::<bool, BLOCKS, _>(|block| b.is_lost(block)), [b.checksum(0), b.checksum(1)])
-        };
-        assert_eq!(observed(&mounted), observed(&built), "a mount of banks that agree leaves the state in_state builds");
+        assert_eq!(observable(&mounted), observable(&built), "a mount of banks that agree leaves the state in_state builds");
         mounted
     }
+}
+
+/// Everything a caller can observe of the banks: both images, both status bytes, the lost
+/// flags and both bank sums.
+#[allow(clippy::type_complexity)]
+pub fn observable<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    banks: &Banks<'_, N, BLOCKS, BLOCK>,
+) -> ([[u8; N]; 2], [BankStatus; 2], [bool; BLOCKS], [u32; 2]) {
+    (images(banks), [banks.status(0), banks.status(1)], core::array::from_fn(|block| banks.is_lost(block)), [banks.checksum(0), banks.checksum(1)])
 }
 
 /// Two pairs of bank images are equal (bank by bank: Kani unrolls the comparison of `N`
@@ -582,6 +588,33 @@ pub fn prop_write_cut<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
     let out = check_write_cut::<N, BLOCKS, BLOCK>(devices, addr, data, cut_at, cut);
     assert!(out.is_clean(), "write of {} bytes at {addr} cut at byte write {cut_at} ({cut:?}): {out:?}", data.len());
     out
+}
+
+/// A write that changes nothing: empty, or reaching past the data area. With a cut armed at
+/// any step it attempts no byte write (so the cut never fires), leaves everything a caller
+/// can observe as it was, and answers `Ok` when its range lies in the data area (an empty
+/// write) and `OutOfRange` otherwise. The reboot after it mounts the same banks that agree,
+/// which `prop_first_mount_settles` proves writes nothing, so every block reads its old
+/// contents: [`prop_write_cut`]'s property for these writes, without a reboot of symbolic
+/// banks.
+pub fn prop_write_outside<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    devices: [CutEeprom<'_, N>; 2],
+    addr: usize,
+    data: &[u8],
+    cut_at: u32,
+    cut: CutByte,
+) {
+    let in_range = addr.checked_add(data.len()).is_some_and(|end| end <= BLOCKS * BLOCK);
+    assert!(data.is_empty() || !in_range, "precondition: an empty write or one past the data area");
+    let power = devices[0].power();
+    let mut banks = mount_agreeing::<N, BLOCKS, BLOCK>(devices);
+    let before = observable(&banks);
+    power.arm(cut_at, cut);
+    let result = banks.write(addr, data);
+    assert_eq!(power.steps(), 0, "a write of {} bytes at {addr} attempted a byte write", data.len());
+    assert_eq!(result, if in_range { Ok(()) } else { Err(Error::OutOfRange) });
+    assert!(observable(&banks) == before, "a write of {} bytes at {addr} changed the banks", data.len());
+    power.restore_power();
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -149,6 +149,15 @@ proptest! {
     }
 
     #[test]
+    fn banks_write_outside_the_data_area_changes_nothing(data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), off in 0..=17_usize, len in 0..=17_usize, bytes in any::<[u8; 17]>(), cut_at in 0..50_u32, cut in banks_small::cut()) {
+        use coforge_verification::banks::*;
+        // Empty anywhere, or ending past the 16 data bytes.
+        let addr = if len == 0 { off } else { 17 - len + off % (len + 1) };
+        let power = Power::new();
+        prop_write_outside::<24, 2, 8>(committed_devices::<24, 2, 8>(&power, &data, &seqs), addr, &bytes[..len], cut_at, cut);
+    }
+
+    #[test]
     fn banks_recovery_is_idempotent(kind in any::<u8>(), data in any::<[[u8; 8]; 2]>(), seqs in any::<[u8; 2]>(), random in any::<[[u8; 24]; 2]>(), mutations in banks_small::mutations()) {
         use coforge_verification::banks::*;
         let power = Power::new();
