@@ -174,6 +174,10 @@ class Sim:
             self.node = canopen.RemoteNode(NODE_ID, od)
             self.node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
             self.net.add_node(self.node)
+            # The hub attaches a client on its own thread after connect() returns, and a frame
+            # sent before that reaches no one (an EMCY right after a console command went
+            # missing about once in 60 runs under load). An answered SDO read means attached.
+            self.node.sdo.upload(0x1000, 0)
             self.serial = SerialHost(serial_url)
         except BaseException:
             self.close()
