@@ -19,7 +19,7 @@ import subprocess
 import tempfile
 import time
 
-from bus import Recorder
+from bus import Recorder, connect_attached
 from simproc import SerialLine, SimProcess
 from qemu import QemuProcess
 import canopen
@@ -183,7 +183,7 @@ class Target:
             self.net = canopen.Network()
             self.rec = Recorder()
             self.net.listeners.insert(0, self.rec)
-            self.net.connect(interface="slcan", channel=can_url, sleep_after_open=0, bitrate=500000)
+            connect_attached(self.net, can_url, 500000)
             self.node = canopen.RemoteNode(NODE_ID, od)
             self.node.sdo.RESPONSE_TIMEOUT = 1.0
             self.net.add_node(self.node)

@@ -29,7 +29,7 @@ import time
 import canopen
 import pytest
 
-from bus import Recorder
+from bus import Recorder, connect_attached
 from card import MTOOLS, copy_out, fsck_clean, listing, new_card
 from qemu import QemuProcess
 from simproc import SimProcess
@@ -112,7 +112,7 @@ class Logger:
             self.net = canopen.Network()
             self.rec = Recorder()
             self.net.listeners.insert(0, self.rec)
-            self.net.connect(interface="slcan", channel=url, sleep_after_open=0, bitrate=125000)
+            connect_attached(self.net, url, 125000)
             self.node = canopen.RemoteNode(NODE, canopen.ObjectDictionary())
             self.node.sdo.RESPONSE_TIMEOUT = 2.0
             self.net.add_node(self.node)

@@ -21,7 +21,7 @@ import time
 import canopen
 import pytest
 
-from bus import Recorder
+from bus import Recorder, connect_attached
 from host import COFORGE, ROOT, connect
 from qemu import QemuProcess
 
@@ -72,7 +72,7 @@ def target(request):
     rec = Recorder()
     net.listeners.insert(0, rec)
     try:
-        net.connect(interface="slcan", channel=t.can_url, sleep_after_open=0, bitrate=1000000)
+        connect_attached(net, t.can_url, 1000000)
         node = canopen.RemoteNode(NODE_ID, canopen.ObjectDictionary())
         node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
         net.add_node(node)

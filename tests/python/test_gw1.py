@@ -26,13 +26,12 @@ for their consequence (a frame, a telegram), not for the console's answer.
 
 import pathlib
 import re
-import socket
 import subprocess
 import tempfile
 import time
 import types
 
-from bus import Recorder
+from bus import Recorder, connect_attached
 from simproc import SerialLine, SimProcess
 import canopen
 import pytest
@@ -224,8 +223,7 @@ class Sim:
             self.net.NOTIFIER_CYCLE = 0.05
             self.rec = Recorder()
             self.net.listeners.insert(0, self.rec)  # sees each frame before python-canopen does
-            self.net.connect(interface="slcan", channel=can_url, sleep_after_open=0, bitrate=500000)
-            self._bus_ready(can_url)
+            connect_attached(self.net, can_url, 500000)
             self.node = canopen.RemoteNode(self.node_id, od)
             self.node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
             self.net.add_node(self.node)
@@ -233,22 +231,6 @@ class Sim:
         except BaseException:
             self.close()
             raise
-
-    def _bus_ready(self, can_url, timeout=5.0):
-        """Waits until the hub delivers bus frames to our client. The hub registers a client
-        on its own thread after the connect returns, and before enable the chip is silent on
-        CAN, so a probe client sends a frame on 7FFh (no COB-ID of the node) until the
-        recorder sees it: otherwise the boot-up that enable causes could go unseen."""
-        host, port = can_url[len("socket://") :].rsplit(":", 1)
-        deadline = time.monotonic() + timeout
-        with socket.create_connection((host, int(port)), timeout=timeout) as probe:
-            probe.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            while True:
-                mark = self.rec.mark()
-                probe.sendall(b"t7FF0\r")
-                if self.rec.wait(0x7FF, mark, 0.2) is not None:
-                    return
-                assert time.monotonic() < deadline, "the hub did not deliver a probe frame to python-can"
 
     def console(self, command, timeout=5.0):
         return self.sim.console(command, timeout)
@@ -368,9 +350,8 @@ def test_boot_phase_bootup_telegrams_and_can_silent(sim):
     sim.nmt(START)
     sim.net.send_message(sim.cob(0x700), b"", remote=True)
     time.sleep(0.2)
-    # (The recorder sees the other clients' frames only: python-canopen's own are not echoed;
-    # 7FFh is the probe of Sim._bus_ready.)
-    assert [str(f) for f in sim.rec.since(mark) if f.id != 0x7FF] == [], "the node sent frames before enable"
+    # (The recorder sees the other clients' frames only: python-canopen's own are not echoed.)
+    assert [str(f) for f in sim.rec.since(mark)] == [], "the node sent frames before enable"
     # 50 00 answers 00 (boot-up) until enable; the boot-up telegrams go on.
     assert host.xfer(h("50 00")) == X("50 01 00")
     n = len(host.bootups)

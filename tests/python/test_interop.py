@@ -26,7 +26,7 @@ import time
 import types
 from dataclasses import dataclass, field
 
-from bus import Recorder
+from bus import Recorder, connect_attached
 import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError, SdoCommunicationError
@@ -221,7 +221,7 @@ def start(eds_file):
         rec = Recorder()
         net.listeners.insert(0, rec)
         try:
-            net.connect(interface="slcan", channel=url, sleep_after_open=0, bitrate=500000)
+            connect_attached(net, url, 500000)
         except Exception:
             proc.kill()
             proc.wait()

@@ -13,6 +13,7 @@ import types
 import canopen
 import pytest
 from serial.urlhandler import protocol_socket
+from bus import connect_attached
 from simproc import SimProcess
 from host import COFORGE, ROOT
 
@@ -67,7 +68,7 @@ def peer():
     url = hub.banner(r"(socket://\S+)")
     net = canopen.Network()
     net.NOTIFIER_CYCLE = 0.05
-    net.connect(interface="slcan", channel=url, sleep_after_open=0, bitrate=500000)
+    connect_attached(net, url, 500000)
     node = canopen.LocalNode(PEER_ID, peer_dictionary())
     net.add_node(node)
     try:

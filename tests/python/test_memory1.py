@@ -30,7 +30,7 @@ import tempfile
 import time
 import types
 
-from bus import Recorder
+from bus import Recorder, connect_attached
 from simproc import SerialLine, SimProcess
 import canopen
 import pytest
@@ -170,14 +170,10 @@ class Sim:
             self.net.NOTIFIER_CYCLE = 0.05
             self.rec = Recorder()
             self.net.listeners.insert(0, self.rec)  # sees each frame before python-canopen does
-            self.net.connect(interface="slcan", channel=can_url, sleep_after_open=0, bitrate=500000)
+            connect_attached(self.net, can_url, 500000)
             self.node = canopen.RemoteNode(NODE_ID, od)
             self.node.sdo.RESPONSE_TIMEOUT = SDO_TIMEOUT
             self.net.add_node(self.node)
-            # The hub attaches a client on its own thread after connect() returns, and a frame
-            # sent before that reaches no one (an EMCY right after a console command went
-            # missing about once in 60 runs under load). An answered SDO read means attached.
-            self.node.sdo.upload(0x1000, 0)
             self.serial = SerialHost(serial_url)
         except BaseException:
             self.close()
