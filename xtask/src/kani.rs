@@ -148,7 +148,9 @@ fn all_harnesses() -> Result<Vec<String>> {
 
 /// The harnesses Kani lists in the crate at `dir`.
 fn list(dir: &std::path::Path) -> Result<Vec<String>> {
-    crate::run(Command::new("cargo").args(["kani", "list", "--format", "json"]).current_dir(dir))?;
+    let mut cmd = Command::new("cargo");
+    cmd.args(["kani", "list", "--format", "json"]).current_dir(dir);
+    crate::run(with_incremental(&mut cmd))?;
     let file = dir.join("kani-list.json");
     let text = std::fs::read_to_string(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
     harness_names(&text)
@@ -298,6 +300,15 @@ fn run_all(names: &[String], limit: Duration, budget: Duration) -> Result<Vec<Ru
     Ok(runs)
 }
 
+/// Kani's compile of a crate with incremental compilation on (cargo's default for the dev
+/// profile), whatever the caller's environment says: with `CARGO_INCREMENTAL=0`, which
+/// `.ci/run` sets, Kani 0.63's compiler panics on `MirroredBanks::settle` ("Found
+/// uninitialized bytes", in the codegen of a constant), and every harness of the crate fails
+/// to compile (stop 38: the fast set in a clean-clone `.ci/run`).
+fn with_incremental(cmd: &mut Command) -> &mut Command {
+    cmd.env("CARGO_INCREMENTAL", "1")
+}
+
 /// Whether `name` runs without reachability checks: see [`WITHOUT_REACH_CHECKS`].
 fn without_reach_checks(name: &str) -> bool {
     WITHOUT_REACH_CHECKS.iter().any(|part| name.contains(part))
@@ -321,6 +332,7 @@ fn start(name: &str, w: usize, out: &std::path::Path) -> Result<Job> {
     }
     let (dir, path) = locate(name);
     cmd.args(["kani", "--harness", path, "--exact", "--target-dir"]).arg(root().join(format!("target/kani-w{w}"))).current_dir(dir).process_group(0);
+    with_incremental(&mut cmd);
     if without_reach_checks(name) {
         cmd.arg("--no-assertion-reach-checks");
     }
@@ -378,6 +390,14 @@ mod tests {
         assert!(without_reach_checks("cr3101/dictionary_proofs::write_keeps_the_rules_logging"));
         assert!(!without_reach_checks("cr3101/dictionary_proofs::read_keeps_the_rules_logging"));
         assert!(!without_reach_checks("harnesses::crc_table_step_equals_bitwise"));
+    }
+
+    #[test]
+    fn kani_compiles_incrementally_even_when_the_caller_turned_it_off() {
+        let mut cmd = Command::new("cargo");
+        cmd.env("CARGO_INCREMENTAL", "0");
+        let envs: Vec<_> = with_incremental(&mut cmd).get_envs().collect();
+        assert_eq!(envs, [(std::ffi::OsStr::new("CARGO_INCREMENTAL"), Some(std::ffi::OsStr::new("1")))]);
     }
 
     #[test]
