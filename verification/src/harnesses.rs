@@ -283,44 +283,12 @@ mod mirrored_banks {
     /// (three mounts reached 1.78 M steps and did not finish in 52 minutes). Any contents
     /// include every state a torn write leaves: the three harnesses of a torn write then a
     /// recovery cut (one per place) that stood here until stop 38 proved a special case.
-    ///
-    /// One harness per six byte writes the cut can hit (a slot's size here): one harness for
-    /// any cut took 63 minutes, most of it in kissat, and a cut confined to a few writes
-    /// leaves the solver fewer cut images to compare. The four ranges cover every `cut_at`;
-    /// the last also every cut past the recovery's last write, which leaves the uncut images.
-    fn recovery_cut(cut_at: core::ops::RangeInclusive<u32>) {
+    #[kani::proof]
+    #[kani::unwind(13)]
+    #[kani::solver(kissat)]
+    fn banks_recovery_cut_at_any_byte_for_any_contents() {
         let power = Power::new();
-        let at: u32 = kani::any();
-        kani::assume(cut_at.contains(&at));
-        prop_recovery_cut::<N, BLOCKS, BLOCK>(any_devices(&power), at, any_cut());
-    }
-
-    #[kani::proof]
-    #[kani::unwind(13)]
-    #[kani::solver(kissat)]
-    fn banks_recovery_cut_at_byte_write_0_to_5_for_any_contents() {
-        recovery_cut(0..=5);
-    }
-
-    #[kani::proof]
-    #[kani::unwind(13)]
-    #[kani::solver(kissat)]
-    fn banks_recovery_cut_at_byte_write_6_to_11_for_any_contents() {
-        recovery_cut(6..=11);
-    }
-
-    #[kani::proof]
-    #[kani::unwind(13)]
-    #[kani::solver(kissat)]
-    fn banks_recovery_cut_at_byte_write_12_to_17_for_any_contents() {
-        recovery_cut(12..=17);
-    }
-
-    #[kani::proof]
-    #[kani::unwind(13)]
-    #[kani::solver(kissat)]
-    fn banks_recovery_cut_at_byte_write_18_or_later_for_any_contents() {
-        recovery_cut(18..=u32::MAX);
+        prop_recovery_cut::<N, BLOCKS, BLOCK>(any_devices(&power), kani::any(), any_cut());
     }
 
     /// (b) The format of blank (erased) banks, cut at any byte write.
