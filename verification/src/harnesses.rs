@@ -146,13 +146,6 @@ mod mirrored_banks {
         CutByte::select(kani::any(), kani::any())
     }
 
-    /// A torn byte holding any value. It covers what `any_cut` does: `Old` and `New` are the
-    /// garbage bytes that equal the old or the new value (`Power::program` treats them so),
-    /// without a three-way choice at every byte write.
-    fn any_torn_byte() -> CutByte {
-        CutByte::Garbage(kani::any())
-    }
-
     /// Any bank contents.
     fn any_devices(power: &Power) -> Devices<'_> {
         [CutEeprom::new(power, kani::any()), CutEeprom::new(power, kani::any())]
@@ -193,15 +186,11 @@ mod mirrored_banks {
         write_cut(0, 3);
     }
 
-    /// Both blocks whole. The torn byte is any value (`any_torn_byte`): with `any_cut`'s
-    /// three-way choice this harness took 46 min (stop 37) and had no verdict after 31 (stop 39).
     #[kani::proof]
     #[kani::unwind(13)]
     #[kani::solver(kissat)]
     fn banks_write_cut_of_4_bytes_at_0_leaves_old_or_new() {
-        let power = Power::new();
-        let data: [u8; BLOCKS * BLOCK] = kani::any();
-        prop_write_cut::<N, BLOCKS, BLOCK>(any_committed(&power), 0, &data, kani::any(), any_torn_byte());
+        write_cut(0, 4);
     }
 
     #[kani::proof]
@@ -458,50 +447,12 @@ mod mirrored_banks {
         step(Op::Write { addr, len, value: kani::any(), step: kani::any() });
     }
 
-    /// The cut write, one harness per place `Op::decode` draws (0..=4, the last one past the
-    /// data area), any length: with the place a constant, the blocks the write touches are
-    /// constants, as in the write-cut harnesses (one harness for any place took 35 min, stop
-    /// 38; verification/README.md).
-    fn cut_write_step_at(addr: usize) {
-        let len: usize = kani::any();
-        kani::assume(addr <= BLOCKS * BLOCK && len <= 2 * BLOCK + 1);
+    #[kani::proof]
+    #[kani::unwind(13)]
+    #[kani::solver(kissat)]
+    fn banks_cut_write_step_from_any_state() {
+        let (addr, len) = any_range();
         step(Op::CutWrite { addr, len, value: kani::any(), cut_at: kani::any(), cut: any_cut() });
-    }
-
-    #[kani::proof]
-    #[kani::unwind(13)]
-    #[kani::solver(kissat)]
-    fn banks_cut_write_step_at_0_from_any_state() {
-        cut_write_step_at(0);
-    }
-
-    #[kani::proof]
-    #[kani::unwind(13)]
-    #[kani::solver(kissat)]
-    fn banks_cut_write_step_at_1_from_any_state() {
-        cut_write_step_at(1);
-    }
-
-    #[kani::proof]
-    #[kani::unwind(13)]
-    #[kani::solver(kissat)]
-    fn banks_cut_write_step_at_2_from_any_state() {
-        cut_write_step_at(2);
-    }
-
-    #[kani::proof]
-    #[kani::unwind(13)]
-    #[kani::solver(kissat)]
-    fn banks_cut_write_step_at_3_from_any_state() {
-        cut_write_step_at(3);
-    }
-
-    /// Past the data area: every write but the empty one is refused.
-    #[kani::proof]
-    #[kani::unwind(13)]
-    #[kani::solver(kissat)]
-    fn banks_cut_write_step_at_4_from_any_state() {
-        cut_write_step_at(4);
     }
 
     #[kani::proof]
