@@ -439,8 +439,7 @@ mod mirrored_banks {
     /// value, only the branches CRCs choose, and the stub lets every branch happen. The
     /// reboot step keeps the real CRC: it asserts that settled blocks are valid, which a CRC
     /// chosen afresh at every call would not repeat. With no CRC circuits the solver has
-    /// less to do: the corruption, check-block and scrub steps took half the time, the write
-    /// step a ninth less (verification/README.md, stop 41).
+    /// less to do (the times before and after: verification/README.md, stop 41).
     fn any_block_crc<const BLOCK: usize>(_data: &[u8; BLOCK], _seq: u8) -> u16 {
         kani::any()
     }
