@@ -604,6 +604,32 @@ pub fn prop_write_cut<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
     out
 }
 
+/// The first piece of a write across blocks, uncut: the rest of a block from `addr`, written
+/// to banks that agree (committed with `seqs`, as [`check_write_cut`] starts from). It answers
+/// `Ok` and leaves banks that agree again: every block committed in both banks, the written
+/// one with its sequence number one up if its data changed, and every block sum, status bit,
+/// lost flag and count a mount of those banks would leave. So when a cut spares the first
+/// piece of a write across blocks (which is then the writes of its pieces in turn,
+/// [`prop_pieces_partition`]), the second piece is a one-block write cut of banks that agree,
+/// which the one-block write-cut harnesses take; when it does not, the write ends there, and
+/// it is the one-block write cut of the first piece.
+pub fn prop_uncut_first_piece_keeps_banks_agreeing<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    power: &Power,
+    data: &[[u8; BLOCK]; BLOCKS],
+    seqs: &[u8; BLOCKS],
+    addr: usize,
+    bytes: &[u8],
+) {
+    assert!(addr < BLOCK && addr + bytes.len() == BLOCK, "precondition: the rest of block 0 from {addr}");
+    let mut banks = mount_agreeing::<N, BLOCKS, BLOCK>(committed_devices::<N, BLOCKS, BLOCK>(power, data, seqs));
+    assert_eq!(banks.write(addr, bytes), Ok(()), "an uncut write of {} bytes at {addr}", bytes.len());
+    let new = written(data, addr, bytes).expect("a range in the data area");
+    let new_seqs: [u8; BLOCKS] = core::array::from_fn(|b| if new[b] == data[b] { seqs[b] } else { seqs[b].wrapping_add(1) });
+    let agreeing = mount_agreeing::<N, BLOCKS, BLOCK>(committed_devices::<N, BLOCKS, BLOCK>(power, &new, &new_seqs));
+    assert!(same_observable(&observable(&banks), &observable(&agreeing)), "{} bytes at {addr} left banks that do not agree", bytes.len());
+    assert!(banks.block_sums() == agreeing.block_sums(), "{} bytes at {addr} left other block sums", bytes.len());
+}
+
 /// A write that changes nothing: empty, or reaching past the data area. With a cut armed at
 /// any step it attempts no byte write (so the cut never fires), leaves everything a caller
 /// can observe as it was, and answers `Ok` when its range lies in the data area (an empty
@@ -924,6 +950,70 @@ pub fn prop_recovery_cut<const N: usize, const BLOCKS: usize, const BLOCK: usize
     let out = check_recovery_cut::<N, BLOCKS, BLOCK>(devices, cut_at, cut);
     assert!(out.is_clean(), "recovery cut at byte write {cut_at} ({cut:?}): {out:?}");
     out
+}
+
+/// Banks on `devices` with no status bit, no lost block and the scrub at block 0. The block
+/// sums are 0: a `check_block` sets the ones it reads, and no bank image depends on them.
+fn fresh_state<S: Storage, const BLOCKS: usize, const BLOCK: usize>(devices: [S; 2]) -> MirroredBanks<S, BLOCKS, BLOCK> {
+    MirroredBanks::in_state(devices, [BankStatus::default(); 2], [[0; BLOCKS]; 2], [false; BLOCKS], 0)
+}
+
+/// The recovery cut, one block at a time: `check_block(block)` of any contents (the steps a
+/// mount takes for each block: both copies loaded, then settled) cut at byte write `cut_at`,
+/// then `check_block(block)` again on what the cut left, uncut. The second leaves the bank
+/// images an uncut first one leaves, and the same lost flag; neither touches another block's
+/// slots; a block that ends lost is never written; the block's copy that wins keeps a valid
+/// copy in place through any cut; and a block that ends not lost holds the same valid copy
+/// in both banks. With [`prop_format_cut_of_settled_banks`] this gives
+/// [`prop_recovery_cut`] for any contents (the argument: verification/README.md, stop 42).
+pub fn prop_block_recovery_cut<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
+    devices: [CutEeprom<'_, N>; 2],
+    block: usize,
+    cut_at: u32,
+    cut: CutByte,
+) {
+    assert_geometry::<N, BLOCKS, BLOCK>();
+    let power = devices[0].power();
+    power.restore_power();
+    let before = [*devices[0].as_bytes(), *devices[1].as_bytes()];
+    power.arm(cut_at, cut);
+    let mut twins: MirroredBanks<TwinEeprom<'_, N>, BLOCKS, BLOCK> = fresh_state([TwinEeprom::new(&devices[0]), TwinEeprom::new(&devices[1])]);
+    let _ = twins.check_block(block);
+    let fired = power.is_off();
+    power.restore_power();
+    let lost = twins.is_lost(block);
+    let [a, b] = twins.banks();
+    let (cut_images, uncut) = ([*a.cut(), *b.cut()], [*a.uncut(), *b.uncut()]);
+    let mut again: Banks<'_, N, BLOCKS, BLOCK> = fresh_state([CutEeprom::new(power, cut_images[0]), CutEeprom::new(power, cut_images[1])]);
+    let _ = again.check_block(block);
+    assert!(same_images(&images(&again), &uncut), "block {block}, cut at {cut_at} ({cut:?}): checked again, not what an uncut check leaves");
+    assert_eq!(again.is_lost(block), lost, "block {block}, cut at {cut_at} ({cut:?}): lost differs");
+    if lost {
+        assert!(!fired && same_images(&uncut, &before), "block {block}: a lost block was written");
+    } else {
+        assert!(copy_is_valid::<BLOCK>(&uncut[0], block) && slot::<BLOCK>(&uncut[0], block) == slot::<BLOCK>(&uncut[1], block), "block {block}: not settled");
+    }
+    if fired {
+        assert!(copy_is_valid::<BLOCK>(&cut_images[0], block) || copy_is_valid::<BLOCK>(&cut_images[1], block), "block {block}: a cut left no valid copy");
+    }
+    for other in 0..BLOCKS {
+        for bank in 0..2 {
+            let kept = slot::<BLOCK>(&before[bank], other);
+            assert!(
+                other == block || (slot::<BLOCK>(&uncut[bank], other) == kept && slot::<BLOCK>(&cut_images[bank], other) == kept),
+                "block {block}: block {other} changed"
+            );
+        }
+    }
+}
+
+/// The recovery cut of settled banks (every block lost or the same valid copy in both banks,
+/// what the block steps of any mount leave): [`prop_recovery_cut`] on them. A mount of such
+/// banks writes nothing before its format, if it formats, so every cut falls in the format.
+pub fn prop_format_cut_of_settled_banks<const N: usize, const BLOCKS: usize, const BLOCK: usize>(devices: [CutEeprom<'_, N>; 2], cut_at: u32, cut: CutByte) {
+    let images = [*devices[0].as_bytes(), *devices[1].as_bytes()];
+    assert!(is_settled::<N, BLOCKS, BLOCK>(&images), "precondition: settled banks");
+    prop_recovery_cut::<N, BLOCKS, BLOCK>(devices, cut_at, cut);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1282,7 +1372,8 @@ fn pattern(len: usize, value: u8, step: u8) -> [u8; MAX_OP_LEN] {
 }
 
 /// A write of `len` bytes of `pattern(value, 1)` at `addr` with the power cut at byte write
-/// `cut_at`, leaving `cut`; the power is back afterwards, before any reboot.
+/// `cut_at`, leaving `cut`; the power is back afterwards, before any reboot. Returns what the
+/// write answered and whether the cut fired.
 pub fn cut_write<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
     banks: &mut Banks<'_, N, BLOCKS, BLOCK>,
     addr: usize,
@@ -1290,12 +1381,14 @@ pub fn cut_write<const N: usize, const BLOCKS: usize, const BLOCK: usize>(
     value: u8,
     cut_at: u32,
     cut: CutByte,
-) {
+) -> (Result<(), Error>, bool) {
     let power = banks.banks()[0].power();
     let data = pattern(len, value, 1);
     power.arm(cut_at, cut);
-    let _ = banks.write(addr, data.get(..len).unwrap_or(&[]));
+    let result = banks.write(addr, data.get(..len).unwrap_or(&[]));
+    let fired = power.is_off();
     power.restore_power();
+    (result, fired)
 }
 
 /// Runs `op` on the banks (no assertion: [`prop_checksum_after_ops`] and [`prop_banks_total`]
@@ -1307,7 +1400,7 @@ pub fn apply<'p, const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut ba
             let _ = banks.write(addr, data.get(..len).unwrap_or(&[]));
         }
         Op::CutWrite { addr, len, value, cut_at, cut } => {
-            cut_write(&mut banks, addr, len, value, cut_at, cut);
+            let _ = cut_write(&mut banks, addr, len, value, cut_at, cut);
             return Banks::mount(banks.into_banks());
         }
         Op::Corrupt { bank, pos, value } => {
@@ -1345,7 +1438,7 @@ pub fn prop_checksum_after_ops<const N: usize, const BLOCKS: usize, const BLOCK:
         let op = Op::decode::<N, BLOCKS, BLOCK>(bytes);
         if let Op::CutWrite { addr, len, value, cut_at, cut } = op {
             // The sums right after the cut, before the reboot.
-            cut_write(&mut banks, addr, len, value, cut_at, cut);
+            let _ = cut_write(&mut banks, addr, len, value, cut_at, cut);
             assert_eq!(checksum_errors(&banks), 0, "right after operation {i} {op:?}");
             banks = Banks::mount(banks.into_banks());
         } else {
@@ -1439,7 +1532,11 @@ pub fn prop_step<const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut ba
     let before = images(&banks);
     let banks = match op {
         Op::CutWrite { addr, len, value, cut_at, cut } => {
-            cut_write(&mut banks, addr, len, value, cut_at, cut);
+            // A write the cut stopped never answers `Ok`: so a write across blocks, which goes
+            // on to its next piece only after an `Ok` (`prop_pieces_partition`), starts that
+            // piece with the power on.
+            let (result, fired) = cut_write(&mut banks, addr, len, value, cut_at, cut);
+            assert!(!(fired && result.is_ok()), "{op:?} answered Ok although the cut stopped it");
             banks
         }
         Op::Reboot => {
@@ -1454,6 +1551,41 @@ pub fn prop_step<const N: usize, const BLOCKS: usize, const BLOCK: usize>(mut ba
     } else if matches!(op, Op::Write { .. } | Op::CutWrite { .. }) {
         assert!(same_images(&images(&banks), &before), "{op:?} changed a byte while a bank does not answer");
     }
+}
+
+/// A write across blocks is the writes of its pieces, one block each, in turn.
+/// `MirroredBanks::write(addr, data)` checks the range, then calls `write_in_block` for each
+/// [`MirroredBanks::piece`] of it (`k` from 0, up to the first `None`), and stops at the first
+/// error. For any range `addr..addr + len` in the data area this checks that the pieces are
+/// consecutive, cover the range and lie in one block each, and that the bytes of one piece,
+/// written alone at their place, have that piece as their only one. So a write calls
+/// `write_in_block` with the same arguments, in the same order, as writing its pieces one
+/// after another (each only after the one before answered `Ok`): what every write within one
+/// block keeps, from any state, every write keeps. The step harness of cut writes relies on
+/// it to take writes within one block only (`harnesses.rs`).
+pub fn prop_pieces_partition<const N: usize, const BLOCKS: usize, const BLOCK: usize>(addr: usize, len: usize) {
+    let end = addr.checked_add(len).filter(|&e| e <= BLOCKS * BLOCK).expect("precondition: a range in the data area");
+    let mut covered = 0;
+    let mut ended = false;
+    for k in 0..BLOCKS {
+        let Some((block, at, range)) = Banks::<N, BLOCKS, BLOCK>::piece(addr, end, k) else {
+            ended = true;
+            continue;
+        };
+        assert!(!ended, "piece {k} of {len} bytes at {addr} comes after the last one");
+        assert!(range.start == covered && range.start < range.end, "piece {k} of {len} bytes at {addr} does not follow the one before");
+        let (from, to) = (addr + range.start, addr + range.end);
+        assert!(block == from / BLOCK && at == from % BLOCK && at + range.len() <= BLOCK, "piece {k} of {len} bytes at {addr} is not in one block");
+        assert!(
+            Banks::<N, BLOCKS, BLOCK>::piece(from, to, 0) == Some((block, at, 0..range.len())),
+            "piece {k} of {len} bytes at {addr} alone is another piece"
+        );
+        for j in 1..BLOCKS {
+            assert!(Banks::<N, BLOCKS, BLOCK>::piece(from, to, j).is_none(), "piece {k} of {len} bytes at {addr} alone has more pieces");
+        }
+        covered = range.end;
+    }
+    assert_eq!(covered, len, "the pieces of {len} bytes at {addr} do not cover them");
 }
 
 // ---------------------------------------------------------------------------------------------

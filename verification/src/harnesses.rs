@@ -157,8 +157,9 @@ mod mirrored_banks {
     /// not carry each byte write at every place a symbolic address could name (one harness
     /// for any place and length did not finish: 2.7 M steps and 16 GB before its solver).
     /// The harnesses below take every in-range place and length in turn (10 of them on 2
-    /// blocks of 2 bytes); `banks_write_cut_out_of_range_or_empty` takes the rest, so together
-    /// they cover any write of 0..=5 bytes at 0..=5.
+    /// blocks of 2 bytes: 4 bytes at 0 by its two one-block pieces, the other 9 each by a
+    /// harness); `banks_write_cut_out_of_range_or_empty` takes the rest, so together they
+    /// cover any write of 0..=5 bytes at 0..=5.
     fn write_cut(addr: usize, len: usize) {
         let power = Power::new();
         let data: [u8; BLOCKS * BLOCK] = kani::any();
@@ -186,11 +187,26 @@ mod mirrored_banks {
         write_cut(0, 3);
     }
 
+    /// (a) A write of 4 bytes at 0 is the writes of 2 bytes at 0 and at 2 in turn
+    /// (`banks_write_pieces_partition_any_range`). A cut in the first leaves what the 2-byte
+    /// write cut at 0 leaves (the write ends there); otherwise the first leaves banks that agree
+    /// (the harness below), and the cut falls in a 2-byte write at 2 of such banks. So the two
+    /// one-block harnesses prove it; as one harness it took 36 to 46 minutes (stops 37 and 40).
+    /// The other writes across blocks are proved both ways.
+    ///
+    /// The first piece of any write across blocks (the rest of block 0 from 0 or 1), uncut,
+    /// leaves banks that agree, committed as a mount of them would find them.
     #[kani::proof]
     #[kani::unwind(13)]
     #[kani::solver(kissat)]
-    fn banks_write_cut_of_4_bytes_at_0_leaves_old_or_new() {
-        write_cut(0, 4);
+    fn banks_uncut_first_piece_keeps_banks_agreeing() {
+        let power = Power::new();
+        let data: [[u8; BLOCK]; BLOCKS] = kani::any();
+        let seqs: [u8; BLOCKS] = kani::any();
+        let bytes: [u8; BLOCK] = kani::any();
+        let addr: usize = kani::any();
+        kani::assume(addr < BLOCK);
+        prop_uncut_first_piece_keeps_banks_agreeing::<N, BLOCKS, BLOCK>(&power, &data, &seqs, addr, &bytes[addr..]);
     }
 
     #[kani::proof]
@@ -278,17 +294,45 @@ mod mirrored_banks {
     }
 
     /// (b) Any contents, the recovery cut at any byte write with any byte left: the reboot
-    /// ends with the contents and images of an uncut recovery. Two mounts of symbolic banks
-    /// since stop 38: one of `TwinEeprom`s gives both the cut images and the uncut reference
-    /// (three mounts reached 1.78 M steps and did not finish in 52 minutes). Any contents
-    /// include every state a torn write leaves: the three harnesses of a torn write then a
-    /// recovery cut (one per place) that stood here until stop 38 proved a special case.
+    /// ends with the contents and images of an uncut recovery. Proved in parts since stop 42
+    /// (as one harness, `banks_recovery_cut_at_any_byte_for_any_contents`, it took 63 minutes
+    /// in stop 38). A mount settles each block in turn (the steps of `check_block`: both
+    /// copies loaded, then settled), then formats if it must. A cut while it settles block
+    /// `b` leaves the blocks before `b` settled, `b` as a cut `check_block` leaves it, and the
+    /// rest as they were; the reboot settles each of them as the uncut mount did (the
+    /// harnesses per block below: a block settled already is a cut that never fired), so it
+    /// takes the same format decision and ends the same. A cut in the format is the recovery
+    /// cut of the settled banks the block steps left (`banks_format_cut_of_settled_banks`).
+    /// The whole argument: verification/README.md, stop 42.
+    fn block_recovery_cut(block: usize) {
+        let power = Power::new();
+        prop_block_recovery_cut::<N, BLOCKS, BLOCK>(any_devices(&power), block, kani::any(), any_cut());
+    }
+
     #[kani::proof]
     #[kani::unwind(13)]
     #[kani::solver(kissat)]
-    fn banks_recovery_cut_at_any_byte_for_any_contents() {
+    fn banks_recovery_cut_of_block_0_for_any_contents() {
+        block_recovery_cut(0);
+    }
+
+    #[kani::proof]
+    #[kani::unwind(13)]
+    #[kani::solver(kissat)]
+    fn banks_recovery_cut_of_block_1_for_any_contents() {
+        block_recovery_cut(1);
+    }
+
+    /// (b) Settled banks (each block lost or the same valid copy in both banks), the recovery
+    /// cut at any byte write: only a format writes, and the reboot finishes it.
+    #[kani::proof]
+    #[kani::unwind(13)]
+    #[kani::solver(kissat)]
+    fn banks_format_cut_of_settled_banks() {
         let power = Power::new();
-        prop_recovery_cut::<N, BLOCKS, BLOCK>(any_devices(&power), kani::any(), any_cut());
+        let images: [[u8; N]; 2] = kani::any();
+        kani::assume(is_settled::<N, BLOCKS, BLOCK>(&images));
+        prop_format_cut_of_settled_banks::<N, BLOCKS, BLOCK>([CutEeprom::new(&power, images[0]), CutEeprom::new(&power, images[1])], kani::any(), any_cut());
     }
 
     /// (b) The format of blank (erased) banks, cut at any byte write.
@@ -461,12 +505,34 @@ mod mirrored_banks {
         step(Op::Write { addr, len, value: kani::any(), step: kani::any() });
     }
 
+    /// Any place and length of [`any_range`] but those of a write across both blocks: a write
+    /// within one block, an empty one, or one past the data area. A write across blocks is
+    /// its two one-block writes in turn, the second only after the first answered `Ok`
+    /// (`banks_write_pieces_partition_any_range`), and a write the cut stopped never answers
+    /// `Ok` (`prop_step`): so the second starts from a running state with the power on and
+    /// any cut still ahead, which this harness covers too.
+    fn any_range_but_across_blocks() -> (usize, usize) {
+        let (addr, len) = any_range();
+        kani::assume(len == 0 || addr + len > BLOCKS * BLOCK || addr / BLOCK == (addr + len - 1) / BLOCK);
+        (addr, len)
+    }
+
+    /// The induction step across the pieces of a write: what the cut-write step proves for
+    /// writes within one block holds for every write. Pure arithmetic on `MirroredBanks::piece`.
+    #[kani::proof]
+    #[kani::unwind(3)]
+    fn banks_write_pieces_partition_any_range() {
+        let (addr, len): (usize, usize) = (kani::any(), kani::any());
+        kani::assume(addr <= BLOCKS * BLOCK && len <= BLOCKS * BLOCK - addr);
+        prop_pieces_partition::<N, BLOCKS, BLOCK>(addr, len);
+    }
+
     #[kani::proof]
     #[kani::unwind(13)]
     #[kani::solver(kissat)]
     #[kani::stub(coforge_storage::record::block_crc, any_block_crc)]
     fn banks_cut_write_step_from_any_state() {
-        let (addr, len) = any_range();
+        let (addr, len) = any_range_but_across_blocks();
         step(Op::CutWrite { addr, len, value: kani::any(), cut_at: kani::any(), cut: any_cut() });
     }
 

@@ -116,6 +116,13 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
         MirroredBanks { banks, status, block_sums, lost, scrub_at }
     }
 
+    /// Each block's sum in each bank, as [`Self::in_state`] takes them: for proofs that a state
+    /// is one `in_state` builds.
+    #[cfg(feature = "proof-states")]
+    pub fn block_sums(&self) -> [[u16; BLOCKS]; 2] {
+        self.block_sums
+    }
+
     /// Writes zeros, committed as sequence 0, to both banks of every lost block (in blank
     /// banks the others are formatted already, or were just repaired from a formatted copy).
     /// Two phases, so that a power cut leaves banks the next mount formats again: first every
@@ -237,8 +244,9 @@ impl<S: Storage, const BLOCKS: usize, const BLOCK: usize> MirroredBanks<S, BLOCK
     /// Piece `k` of the data range `addr..end` (at most one per block, in block order): its
     /// block, its offset in the block and its place in the range; `None` past the last one.
     /// Callers loop `k` over `0..BLOCKS`, a constant bound: Kani (CBMC) unrolled a loop over an
-    /// iterator of the pieces to the harness's bound when `addr` was symbolic.
-    fn piece(addr: usize, end: usize, k: usize) -> Option<(usize, usize, Range<usize>)> {
+    /// iterator of the pieces to the harness's bound when `addr` was symbolic. Public for the
+    /// proofs (`coforge-verification`): a read or write across blocks is its pieces in turn.
+    pub fn piece(addr: usize, end: usize, k: usize) -> Option<(usize, usize, Range<usize>)> {
         let block = addr.checked_div(BLOCK)?.checked_add(k)?;
         let start = block.checked_mul(BLOCK)?;
         let (from, to) = (start.max(addr), start.checked_add(BLOCK)?.min(end));
