@@ -20,6 +20,7 @@ pub mod inputs;
 pub mod integrity;
 pub mod manager;
 pub mod node;
+pub mod rng;
 pub mod stack;
 
 #[cfg(kani)]

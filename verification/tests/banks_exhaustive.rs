@@ -4,6 +4,7 @@
 //! turn, and operation sequences. Every test prints its counts (`--nocapture`).
 
 use coforge_verification::banks::*;
+use coforge_verification::rng::Rng;
 
 const N: usize = 8448;
 const BLOCKS: usize = 64;
@@ -11,26 +12,6 @@ const BLOCK: usize = 128;
 const SLOT: usize = BLOCK + 4;
 
 type Full<'p> = Banks<'p, N, BLOCKS, BLOCK>;
-
-/// A deterministic pseudo-random byte stream (xorshift64*).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn byte(&mut self) -> u8 {
-        (self.next() >> 56) as u8
-    }
-    fn fill(&mut self, bytes: &mut [u8]) {
-        for b in bytes {
-            *b = self.byte();
-        }
-    }
-}
 
 /// Sequence numbers of the filled banks: block 2 is at 255, so a write to it wraps to 0.
 fn seq(block: usize) -> u8 {
@@ -434,7 +415,7 @@ fn bank_sums_follow_every_operation_and_any_contents_are_handled() {
             1 => devices[case / 4 % 2] = CutEeprom::erased(&power),
             2 => {
                 for _ in 0..200 {
-                    let (bank, pos) = (rng.byte() as usize % 2, rng.next() as usize % N);
+                    let (bank, pos) = (rng.byte() as usize % 2, rng.next_u64() as usize % N);
                     devices[bank].as_bytes_mut()[pos] = rng.byte();
                 }
             }

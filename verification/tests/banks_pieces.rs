@@ -7,22 +7,11 @@
 
 use coforge_storage::Error;
 use coforge_verification::banks::*;
+use coforge_verification::rng::Rng;
 
 const N: usize = 12;
 const BLOCKS: usize = 2;
 const BLOCK: usize = 2;
-
-/// A deterministic pseudo-random byte stream (xorshift64*).
-struct Rng(u64);
-
-impl Rng {
-    fn byte(&mut self) -> u8 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 56) as u8
-    }
-}
 
 /// A running state as `running_banks` builds it: committed banks with up to 3 bytes changed,
 /// or garbage, a bank silent now and then, any status, lost flags and scrub position.

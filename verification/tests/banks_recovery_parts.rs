@@ -7,23 +7,12 @@
 
 use coforge_storage::record::Record;
 use coforge_verification::banks::*;
+use coforge_verification::rng::Rng;
 
 const N: usize = 12;
 const BLOCKS: usize = 2;
 const BLOCK: usize = 2;
 const SLOT: usize = BLOCK + 4;
-
-/// A deterministic pseudo-random byte stream (xorshift64*).
-struct Rng(u64);
-
-impl Rng {
-    fn byte(&mut self) -> u8 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 56) as u8
-    }
-}
 
 /// A committed slot: `data`, then its record with `seq`.
 fn committed(data: [u8; BLOCK], seq: u8) -> [u8; SLOT] {
